@@ -1,0 +1,64 @@
+#pragma once
+/// \file
+/// \brief Recursive Newton-Euler inverse dynamics (paper sections III-B and III-C).
+
+#include <type_traits>
+
+#include <Eigen/Core>
+
+#include "softrne/algorithms/kinematics.hpp"
+#include "softrne/algorithms/rnea_steps.hpp"
+
+namespace softrne {
+namespace detail {
+
+/// \brief The two passes on the kinematics already in data; result in data.tau.
+/// \param with_gravity start the forward pass with base acceleration -g.
+/// \param velocity_terms keep the velocity-product terms (false for columns of M).
+template <class ChainT, class Qd, class Qdd>
+void rnea_passes(const ChainT& chain, typename ChainT::Data& data,
+                 const Eigen::MatrixBase<Qd>& qdot, const Eigen::MatrixBase<Qdd>& qddot,
+                 bool with_gravity, bool velocity_terms) {
+  using Scalar = typename ChainT::Scalar;
+  auto& base = data.motion[0];
+  base.omega.setZero();
+  base.alpha.setZero();
+  if (with_gravity)
+    base.acc = -chain.gravity;
+  else
+    base.acc.setZero();
+  chain.forward(data, [&](const auto& seg, const auto& kin, int i, int offset) {
+    constexpr int n = std::decay_t<decltype(seg)>::nq;
+    const auto k = static_cast<std::size_t>(i);
+    forward_step(seg, kin, data.motion[k], qdot.template segment<n>(offset),
+                 qddot.template segment<n>(offset), velocity_terms, chain.inertia_rate,
+                 data.motion[k + 1], data.loads[k]);
+  });
+  data.wrench[static_cast<std::size_t>(data.num_segments())] = Wrench<Scalar>{};
+  chain.backward(data, [&](const auto& seg, const auto& kin, int i, int offset) {
+    constexpr int n = std::decay_t<decltype(seg)>::nq;
+    const auto k = static_cast<std::size_t>(i);
+    backward_step(seg, kin, data.loads[k], data.wrench[k + 1], chain.inertia_rate,
+                  data.tau.template segment<n>(offset), data.wrench[k]);
+  });
+}
+
+}  // namespace detail
+
+/// \brief Inverse dynamics: the generalised forces \f$\tau = M(q)\ddot q + C(q,\dot q)\dot q +
+/// G(q)\f$ of the chain's inertia and gravity (springs, dampers and pressures are not part of
+/// it; see forward_dynamics.hpp). Cost: one kinematics pass and two O(n) recursions.
+/// \return data.tau
+template <class ChainT, class Q, class Qd, class Qdd>
+const typename ChainT::VectorQ& rnea(const ChainT& chain, typename ChainT::Data& data,
+                                     const Eigen::MatrixBase<Q>& q,
+                                     const Eigen::MatrixBase<Qd>& qdot,
+                                     const Eigen::MatrixBase<Qdd>& qddot) {
+  SOFTRNE_ASSERT(qddot.size() == chain.num_coordinates(),
+                 "rnea: qddot must have num_coordinates() entries");
+  compute_kinematics(chain, data, q, qdot);
+  detail::rnea_passes(chain, data, qdot, qddot, true, true);
+  return data.tau;
+}
+
+}  // namespace softrne

@@ -1,0 +1,125 @@
+#pragma once
+/// \file
+/// \brief The two step bodies of the recursive Newton-Euler algorithm, written once for every
+/// segment type and both kinds of chain.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "softrne/chain/motion.hpp"
+
+namespace softrne {
+namespace detail {
+
+/// \brief Forward step (paper eqs. 11-15) across one segment: from the motion of its base
+/// frame to that of its distal frame, and the d'Alembert load of its own body.
+/// \param velocity_terms false drops every velocity-product term (used for the columns of M,
+/// where qdot = 0 but the kinematics were computed at another qdot).
+template <class Segment, class Qd, class Qdd>
+void forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
+                  const FrameMotion<typename Segment::Scalar>& base,
+                  const Eigen::MatrixBase<Qd>& qdot, const Eigen::MatrixBase<Qdd>& qddot,
+                  bool velocity_terms, InertiaRate inertia_rate,
+                  FrameMotion<typename Segment::Scalar>& distal,
+                  BodyLoad<typename Segment::Scalar>& load) {
+  using Scalar = typename Segment::Scalar;
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  constexpr int nq = Segment::nq;
+  const auto& R = kin.R_base_distal;
+  const Vector3& r_e = kin.r_base_distal;
+
+  // Relative twist and its rate, in the base frame (eq. 7).
+  Vector3 v_rel = Vector3::Zero(), w_rel = Vector3::Zero();
+  Vector3 a_rel = Vector3::Zero(), dw_rel = Vector3::Zero();
+  if constexpr (nq > 0) {
+    v_rel = kin.J_distal.template topRows<3>() * qdot;
+    w_rel = kin.J_distal.template bottomRows<3>() * qdot;
+    a_rel = kin.J_distal.template topRows<3>() * qddot;
+    dw_rel = kin.J_distal.template bottomRows<3>() * qddot;
+    if (velocity_terms) {
+      a_rel += kin.Jdot_qdot_distal.template head<3>();
+      dw_rel += kin.Jdot_qdot_distal.template tail<3>();
+    }
+  }
+  const Vector3& w = base.omega;
+  const Vector3& dw = base.alpha;
+  const Vector3 omega = w + w_rel;                     // eq. 11
+  const Vector3 alpha = dw + dw_rel + w.cross(w_rel);  // eq. 12
+  // Eq. 15: acceleration of the distal origin (velocity of a point in a rotating frame).
+  Vector3 acc_e = base.acc + dw.cross(r_e) + a_rel;
+  if (velocity_terms) acc_e += w.cross(w.cross(r_e)) + Scalar(2) * w.cross(v_rel);
+  distal.omega.noalias() = R.transpose() * omega;
+  distal.alpha.noalias() = R.transpose() * alpha;
+  distal.acc.noalias() = R.transpose() * acc_e;
+
+  if constexpr (Segment::has_body) {
+    const Vector3& r_c = kin.r_base_com;
+    // Eq. 14 with the centre of mass's own relative velocity and acceleration
+    // (the paper writes a_{e,rel} there; it must be a_{c,rel}).
+    Vector3 acc_c = base.acc + dw.cross(r_c);
+    if constexpr (nq > 0) acc_c += kin.J_com * qddot;
+    if (velocity_terms) {
+      acc_c += w.cross(w.cross(r_c));
+      if constexpr (nq > 0) acc_c += Scalar(2) * w.cross(kin.J_com * qdot) + kin.Jdot_qdot_com;
+    }
+    load.force = seg.mass * acc_c;  // eq. 16 (gravity is in base.acc)
+    // Eq. 18 in the distal frame, plus the rate of the configuration-dependent inertia.
+    const auto& I = kin.inertia_com;
+    Vector3 torque = I * distal.alpha;
+    if (velocity_terms) {
+      torque += distal.omega.cross(I * distal.omega);
+      if constexpr (nq > 0) {
+        if (inertia_rate == InertiaRate::Consistent) torque += kin.inertia_rate * distal.omega;
+      }
+    }
+    load.torque.noalias() = R * torque;
+    load.omega_distal = velocity_terms ? distal.omega : Vector3::Zero();
+  }
+}
+
+/// \brief Backward step (paper eqs. 16-17): from the wrench that segment i passes on to its
+/// children (about its distal origin, distal frame) to the wrench at its base (about the base
+/// origin, base frame), and the segment's generalised forces.
+///
+/// The generalised forces are the power-conjugate projections of the loads: the wrench
+/// transmitted to the children through the distal frame's Jacobian, the segment's own body
+/// through its centre-of-mass and angular Jacobians. (Taking the x/y torque components at a
+/// frame is not the same: the tip of a CC joint moves about half as far as a rigid rotation
+/// about its base would move it.)
+template <class Segment, class Tau>
+void backward_step(const Segment&, const typename Segment::Kinematics& kin,
+                   const BodyLoad<typename Segment::Scalar>& load,
+                   const Wrench<typename Segment::Scalar>& distal, InertiaRate inertia_rate,
+                   const Eigen::MatrixBase<Tau>& tau_out, Wrench<typename Segment::Scalar>& base) {
+  using Scalar = typename Segment::Scalar;
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  constexpr int nq = Segment::nq;
+  const auto& R = kin.R_base_distal;
+  const Vector3 F = R * distal.force;
+  const Vector3 N = R * distal.torque;
+  if constexpr (nq > 0) {
+    auto& tau = const_cast<Eigen::MatrixBase<Tau>&>(tau_out);
+    tau.noalias() = kin.J_distal.template topRows<3>().transpose() * F;
+    tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * N;
+    if constexpr (Segment::has_body) {
+      tau.noalias() += kin.J_com.transpose() * load.force;
+      tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * load.torque;
+      if (inertia_rate == InertiaRate::Consistent) {
+        // -dT/dq_k of the rotational energy 1/2 w^T I(q) w.
+        for (int k = 0; k < nq; ++k)
+          tau(k) -= Scalar(0.5) * load.omega_distal.dot(
+                                      kin.dinertia_dq[static_cast<std::size_t>(k)] *
+                                      load.omega_distal);
+      }
+    }
+  }
+  base.force = F;
+  base.torque = N + kin.r_base_distal.cross(F);
+  if constexpr (Segment::has_body) {
+    base.force += load.force;
+    base.torque += load.torque + kin.r_base_com.cross(load.force);
+  }
+}
+
+}  // namespace detail
+}  // namespace softrne

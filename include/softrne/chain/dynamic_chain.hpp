@@ -1,0 +1,140 @@
+#pragma once
+/// \file
+/// \brief Chain whose segments are chosen at run time (e.g. read from a robot file).
+
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "softrne/chain/motion.hpp"
+#include "softrne/config.hpp"
+#include "softrne/segments/segment_list.hpp"
+
+namespace softrne {
+
+template <class Scalar>
+struct DynamicChainData;
+
+/// \brief A serial chain of `AnySegment`s, base to tip. Same algorithms as `Chain<...>`: the
+/// traversal visits each variant and calls the same generic step bodies.
+///
+/// Build it with `add(...)`, then `make_data()` once; evaluation allocates nothing.
+template <class Scalar_>
+class DynamicChain {
+ public:
+  using Scalar = Scalar_;
+  using VectorQ = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  using MatrixQ = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using Data = DynamicChainData<Scalar>;
+  using Segment = AnySegment<Scalar>;
+
+  Vector3 gravity = Vector3(Scalar(0), Scalar(0), Scalar(-9.81));  ///< in the base frame
+  InertiaRate inertia_rate = InertiaRate::Consistent;
+
+  /// \brief Appends a segment at the tip; `name` is used in messages and file columns.
+  template <class S>
+  void add(S segment, std::string name = {}) {
+    offsets_.push_back(nq_);
+    nq_ += S::nq;
+    segments_.emplace_back(std::move(segment));
+    names_.push_back(std::move(name));
+  }
+
+  int num_segments() const { return static_cast<int>(segments_.size()); }
+  int num_coordinates() const { return nq_; }
+  int q_offset(int i) const { return offsets_[static_cast<std::size_t>(i)]; }
+  const Segment& segment(int i) const { return segments_[static_cast<std::size_t>(i)]; }
+  Segment& segment(int i) { return segments_[static_cast<std::size_t>(i)]; }
+  const std::string& name(int i) const { return names_[static_cast<std::size_t>(i)]; }
+  Data make_data() const { return Data(*this); }
+
+  /// \brief Calls f(segment, kinematics, index, q_offset) base to tip.
+  template <class F>
+  void forward(Data& data, F&& f) const {
+    check(data);
+    for (int i = 0; i < num_segments(); ++i) visit(data, f, i);
+  }
+  /// \brief Calls f(segment, kinematics, index, q_offset) tip to base.
+  template <class F>
+  void backward(Data& data, F&& f) const {
+    check(data);
+    for (int i = num_segments() - 1; i >= 0; --i) visit(data, f, i);
+  }
+
+  template <class NewScalar>
+  DynamicChain<NewScalar> cast() const {
+    DynamicChain<NewScalar> c;
+    for (int i = 0; i < num_segments(); ++i)
+      std::visit([&](const auto& s) { c.add(s.template cast<NewScalar>(), name(i)); },
+                 segment(i));
+    c.gravity = gravity.template cast<NewScalar>();
+    c.inertia_rate = inertia_rate;
+    return c;
+  }
+
+ private:
+  template <class F>
+  void visit(Data& data, F& f, int i) const {
+    const auto k = static_cast<std::size_t>(i);
+    std::visit(
+        [&](const auto& seg) {
+          using Kin = typename std::decay_t<decltype(seg)>::Kinematics;
+          f(seg, std::get<Kin>(data.kinematics[k]), i, offsets_[k]);
+        },
+        segments_[k]);
+  }
+  void check(const Data& data) const {
+    SOFTRNE_ASSERT(data.kinematics.size() == segments_.size() &&
+                       static_cast<int>(data.tau.size()) == nq_,
+                   "DynamicChain: this Data was made for another chain (call make_data())");
+    (void)data;
+  }
+
+  std::vector<Segment> segments_;
+  std::vector<std::string> names_;
+  std::vector<int> offsets_;
+  int nq_ = 0;
+};
+
+/// \brief Per-evaluation workspace of a runtime chain, sized once by the chain.
+template <class Scalar>
+struct DynamicChainData {
+  using VectorQ = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  using MatrixQ = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+
+  std::vector<AnySegmentKinematics<Scalar>> kinematics;
+  std::vector<FrameMotion<Scalar>> motion;
+  std::vector<BodyLoad<Scalar>> loads;
+  std::vector<Wrench<Scalar>> wrench;
+  VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit;
+  MatrixQ mass_matrix;
+
+  DynamicChainData() = default;
+  explicit DynamicChainData(const DynamicChain<Scalar>& chain) {
+    const auto n = static_cast<std::size_t>(chain.num_segments());
+    const int nq = chain.num_coordinates();
+    kinematics.reserve(n);
+    for (int i = 0; i < chain.num_segments(); ++i)
+      std::visit(
+          [&](const auto& seg) {
+            kinematics.emplace_back(typename std::decay_t<decltype(seg)>::Kinematics{});
+          },
+          chain.segment(i));
+    motion.resize(n + 1);
+    loads.resize(n);
+    wrench.resize(n + 1);
+    tau = VectorQ::Zero(nq);
+    gravity_forces = VectorQ::Zero(nq);
+    bias_forces = VectorQ::Zero(nq);
+    qdot_zero = VectorQ::Zero(nq);
+    unit = VectorQ::Zero(nq);
+    mass_matrix = MatrixQ::Zero(nq, nq);
+  }
+  int num_segments() const { return static_cast<int>(kinematics.size()); }
+};
+
+}  // namespace softrne

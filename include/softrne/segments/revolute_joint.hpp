@@ -1,0 +1,61 @@
+#pragma once
+/// \file
+/// \brief Massless revolute joint about a unit axis at the base-frame origin.
+
+#include <cmath>
+
+#include <Eigen/Core>
+
+#include "softrne/segments/segment_kinematics.hpp"
+#include "softrne/spatial/skew.hpp"
+
+namespace softrne {
+
+/// \brief One coordinate q: rotation by q about `axis` (unit, base frame) at the origin; the
+/// distal frame origin coincides with the base one. Massless: mass comes from the links
+/// around it (formats.md, `revolute_joint`).
+template <class Scalar_>
+struct RevoluteJoint {
+  using Scalar = Scalar_;
+  static constexpr int nq = 1;
+  static constexpr bool has_body = false;
+  using Kinematics = SegmentKinematics<Scalar, nq>;
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+
+  Vector3 axis = Vector3::UnitZ();
+  Scalar stiffness{0};  ///< N m/rad
+  Scalar damping{0};    ///< N m s/rad
+  Scalar mass{0};       ///< always zero; present so every segment answers `mass`
+
+  /// \brief \f$-k q - d \dot q\f$.
+  template <class Q, class Qd>
+  Eigen::Matrix<Scalar, 1, 1> passive_force(const Eigen::MatrixBase<Q>& q,
+                                            const Eigen::MatrixBase<Qd>& qdot) const {
+    return Eigen::Matrix<Scalar, 1, 1>(-(stiffness * q(0) + damping * qdot(0)));
+  }
+
+  int num_inputs() const { return 0; }
+
+  template <class Q, class Qd>
+  void calc(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>&, Kinematics& kin) const {
+    using std::cos;
+    using std::sin;
+    const Scalar c = cos(q(0)), s = sin(q(0));
+    const Matrix3 K = skew(axis);
+    kin.R_base_distal = Matrix3::Identity() + s * K + (Scalar(1) - c) * K * K;
+    kin.J_distal.template topRows<3>().setZero();
+    kin.J_distal.template bottomRows<3>() = axis;
+  }
+
+  template <class NewScalar>
+  RevoluteJoint<NewScalar> cast() const {
+    RevoluteJoint<NewScalar> j;
+    j.axis = axis.template cast<NewScalar>();
+    j.stiffness = NewScalar(stiffness);
+    j.damping = NewScalar(damping);
+    return j;
+  }
+};
+
+}  // namespace softrne

@@ -1,0 +1,15 @@
+#pragma once
+/// \file
+/// \brief Umbrella header of the core library (needs Eigen only).
+
+#include "softrne/config.hpp"
+#include "softrne/segments/constant_curvature_joint.hpp"
+#include "softrne/segments/revolute_joint.hpp"
+#include "softrne/segments/rigid_link.hpp"
+#include "softrne/segments/segment_list.hpp"
+#include "softrne/chain/static_chain.hpp"
+#include "softrne/chain/dynamic_chain.hpp"
+#include "softrne/algorithms/kinematics.hpp"
+#include "softrne/algorithms/rnea.hpp"
+#include "softrne/algorithms/bias.hpp"
+#include "softrne/algorithms/mass_matrix.hpp"

@@ -1,0 +1,79 @@
+#pragma once
+// Test helpers shared by the core tests: random states, AutoDiff types, example chains.
+
+#include <random>
+
+#include <Eigen/Core>
+#include <unsupported/Eigen/AutoDiff>
+
+#include "softrne/softrne.hpp"
+
+namespace softrne_test {
+
+using AD = Eigen::AutoDiffScalar<Eigen::VectorXd>;
+using Eigen::VectorXd;
+
+/// Seeded uniform random vector in [-scale, scale].
+inline VectorXd random_vector(std::mt19937& rng, int n, double scale) {
+  std::uniform_real_distribution<double> d(-scale, scale);
+  VectorXd v(n);
+  for (int i = 0; i < n; ++i) v(i) = d(rng);
+  return v;
+}
+
+/// Active AutoDiff vector: entry i has derivative e_{offset+i} out of `total`.
+inline Eigen::Matrix<AD, Eigen::Dynamic, 1> make_active(const VectorXd& x, int offset, int total) {
+  Eigen::Matrix<AD, Eigen::Dynamic, 1> a(x.size());
+  for (int i = 0; i < x.size(); ++i) a(i) = AD(x(i), total, offset + i);
+  return a;
+}
+
+template <class S>
+softrne::ConstantCurvatureJoint<S> paper_cc(double mass = 0.8, double h = 0.2, double D = 0.2) {
+  softrne::ConstantCurvatureJoint<S> cc;
+  cc.mass = S(mass);
+  cc.height = S(h);
+  cc.diameter = S(D);
+  cc.stiffness << S(30), S(25);
+  cc.damping << S(2), S(1.5);
+  return cc;
+}
+
+template <class S>
+softrne::RigidLink<S> paper_link(double mass = 1.5, double length = 0.15) {
+  softrne::RigidLink<S> l;
+  l.mass = S(mass);
+  l.length = S(length);
+  l.com << S(0.01), S(-0.02), S(length / 2);
+  l.inertia << S(0.0052), S(0.0003), S(-0.0001), S(0.0003), S(0.0050), S(0.0002), S(-0.0001),
+      S(0.0002), S(0.0048);
+  return l;
+}
+
+template <class S>
+softrne::RevoluteJoint<S> revolute(double ax, double ay, double az, double k = 0.5, double d = 0.1) {
+  softrne::RevoluteJoint<S> r;
+  r.axis = Eigen::Vector3d(ax, ay, az).normalized().cast<S>();
+  r.stiffness = S(k);
+  r.damping = S(d);
+  return r;
+}
+
+/// The paper's arm: three CC joints, each followed by a rigid link, hanging (gravity +z).
+inline softrne::DynamicChain<double> paper_arm() {
+  softrne::DynamicChain<double> c;
+  for (int j = 0; j < 3; ++j) {
+    c.add(paper_cc<double>(0.8, 0.2, 0.2), "joint" + std::to_string(j + 1));
+    c.add(paper_link<double>(j == 2 ? 0.4 : 1.5, j == 2 ? 0.05 : 0.15),
+          "link" + std::to_string(j + 1));
+  }
+  c.gravity << 0.0, 0.0, 9.81;
+  return c;
+}
+
+/// Max |a - b| / max(1, |b|_inf).
+inline double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+}
+
+}  // namespace softrne_test
