@@ -11,6 +11,9 @@
 namespace softrne_test {
 
 using AD = Eigen::AutoDiffScalar<Eigen::VectorXd>;
+/// Fixed-size derivatives: constants get zero derivatives, so mixed expressions stay coherent.
+template <int NV>
+using ADN = Eigen::AutoDiffScalar<Eigen::Matrix<double, NV, 1>>;
 using Eigen::VectorXd;
 
 /// Seeded uniform random vector in [-scale, scale].
@@ -22,9 +25,10 @@ inline VectorXd random_vector(std::mt19937& rng, int n, double scale) {
 }
 
 /// Active AutoDiff vector: entry i has derivative e_{offset+i} out of `total`.
-inline Eigen::Matrix<AD, Eigen::Dynamic, 1> make_active(const VectorXd& x, int offset, int total) {
-  Eigen::Matrix<AD, Eigen::Dynamic, 1> a(x.size());
-  for (int i = 0; i < x.size(); ++i) a(i) = AD(x(i), total, offset + i);
+template <class ADT = AD>
+Eigen::Matrix<ADT, Eigen::Dynamic, 1> make_active(const VectorXd& x, int offset, int total) {
+  Eigen::Matrix<ADT, Eigen::Dynamic, 1> a(x.size());
+  for (int i = 0; i < x.size(); ++i) a(i) = ADT(x(i), total, offset + i);
   return a;
 }
 

@@ -1,0 +1,308 @@
+// The generic RNE against the Euler-Lagrange equations of the lumped energy, differentiated
+// with AutoDiff; cross-identities between rnea, gravity, bias and mass_matrix; static chain
+// == runtime chain; closed-form statics; no heap allocation.
+#define EIGEN_RUNTIME_NO_MALLOC
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "softrne/softrne.hpp"
+#include "support.hpp"
+
+namespace {
+
+using namespace softrne;
+using softrne_test::AD;
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+// ---------------------------------------------------------------------------------------
+// Euler-Lagrange reference. T and V are computed here from scratch: the segments give only
+// their own pose, Jacobians and inertia; velocities are propagated in the world frame by this
+// helper (no RNE code), and AutoDiff differentiates T and V.
+template <class ChainT, class QV>
+void energies(const ChainT& chain, const QV& q, const QV& qd, typename ChainT::Scalar& T,
+              typename ChainT::Scalar& V) {
+  using S = typename ChainT::Scalar;
+  using V3 = Eigen::Matrix<S, 3, 1>;
+  using M3 = Eigen::Matrix<S, 3, 3>;
+  auto data = chain.make_data();
+  compute_kinematics(chain, data, q, qd);
+  M3 R = M3::Identity();
+  V3 p = V3::Zero(), v = V3::Zero(), w = V3::Zero();
+  T = S(0);
+  V = S(0);
+
+  chain.forward(data, [&](const auto& seg, const auto& kin, int, int off) {
+    constexpr int n = std::decay_t<decltype(seg)>::nq;
+    V3 v_rel = V3::Zero(), w_rel = V3::Zero(), vc_rel = V3::Zero();
+    if constexpr (n > 0) {
+      const auto qds = qd.template segment<n>(off);
+      v_rel = kin.J_distal.template topRows<3>() * qds;
+      w_rel = kin.J_distal.template bottomRows<3>() * qds;
+      vc_rel = kin.J_com * qds;
+    }
+    const V3 w_body = w + R * w_rel;  // world angular velocity of the distal frame
+    if constexpr (std::decay_t<decltype(seg)>::has_body) {
+      const V3 vc = v + w.cross(R * kin.r_base_com) + R * vc_rel;
+      const M3 Rd = R * kin.R_base_distal;
+      const V3 wb = Rd.transpose() * w_body;
+      T += S(0.5) * seg.mass * vc.squaredNorm() + S(0.5) * wb.dot(kin.inertia_com * wb);
+      V -= seg.mass * chain.gravity.dot(p + R * kin.r_base_com);
+    }
+    v = v + w.cross(R * kin.r_base_distal) + R * v_rel;
+    p = p + R * kin.r_base_distal;
+    R = R * kin.R_base_distal;
+    w = w_body;
+  });
+}
+
+// dT/dq, dT/dqd, dV/dq at (q, qd) by AutoDiff over the 2n variables.
+template <class ChainAD>
+void lagrangian_gradients(const ChainAD& chain_ad, const VectorXd& q, const VectorXd& qd,
+                          VectorXd& dT_dq, VectorXd& dT_dqd, VectorXd& dV_dq) {
+  const int n = static_cast<int>(q.size());
+  using ADT = typename ChainAD::Scalar;
+  using QV = Eigen::Matrix<ADT, Eigen::Dynamic, 1>;
+  QV qa = softrne_test::make_active<ADT>(q, 0, 2 * n), qda = softrne_test::make_active<ADT>(qd, n, 2 * n);
+  ADT T, V;
+  energies(chain_ad, qa, qda, T, V);
+  VectorXd gT = T.derivatives(), gV = V.derivatives();
+  dT_dq = gT.head(n);
+  dT_dqd = gT.tail(n);
+  dV_dq = gV.head(n);
+}
+
+// tau = d/dt(dT/dqd) - dT/dq + dV/dq; the time derivative by an 8th-order central difference
+// along q(t) = q + t qd + t^2/2 qdd (AutoDiff gives the partials exactly).
+template <class ChainAD>
+VectorXd euler_lagrange(const ChainAD& chain_ad, const VectorXd& q, const VectorXd& qd,
+                        const VectorXd& qdd) {
+  VectorXd dTq, dTqd, dVq;
+  lagrangian_gradients(chain_ad, q, qd, dTq, dTqd, dVq);
+  const double c[4] = {4.0 / 5, -1.0 / 5, 4.0 / 105, -1.0 / 280};
+  const double h = 2e-3;
+  VectorXd ddt = VectorXd::Zero(q.size());
+  for (int k = 1; k <= 4; ++k) {
+    for (int sgn : {1, -1}) {
+      const double t = sgn * k * h;
+      VectorXd a, b, e;
+      lagrangian_gradients(chain_ad, VectorXd(q + t * qd + 0.5 * t * t * qdd), VectorXd(qd + t * qdd), a, b, e);
+      ddt += sgn * c[k - 1] * b / h;
+    }
+  }
+  return ddt - dTq + dVq;
+}
+
+DynamicChain<double> cc_only() {
+  DynamicChain<double> c;
+  c.add(softrne_test::paper_cc<double>(0.8, 0.2, 0.2), "j1");
+  c.add(softrne_test::paper_cc<double>(0.5, 0.15, 0.12), "j2");
+  c.add(softrne_test::paper_cc<double>(0.3, 0.1, 0.1), "j3");
+  c.gravity << 0.3, -1.0, 9.81;
+  return c;
+}
+
+DynamicChain<double> hybrid() {
+  DynamicChain<double> c;
+  c.add(softrne_test::revolute<double>(0, 0, 1), "yaw");
+  c.add(softrne_test::paper_link<double>(1.0, 0.1), "l0");
+  c.add(softrne_test::paper_cc<double>(0.8, 0.2, 0.2), "j1");
+  c.add(softrne_test::paper_link<double>(1.5, 0.15), "l1");
+  c.add(softrne_test::revolute<double>(1, 0.2, 0), "elbow");
+  c.add(softrne_test::paper_link<double>(0.7, 0.2), "l2");
+  c.add(softrne_test::paper_cc<double>(0.4, 0.12, 0.1), "j2");
+  c.add(softrne_test::paper_link<double>(0.3, 0.05), "tip");
+  c.gravity << 0.0, 0.0, -9.81;
+  return c;
+}
+
+DynamicChain<double> long_chain(int n_cc) {
+  DynamicChain<double> c;
+  for (int i = 0; i < n_cc; ++i) {
+    c.add(softrne_test::paper_cc<double>(0.1, 0.05, 0.04), "j" + std::to_string(i));
+    c.add(softrne_test::paper_link<double>(0.05, 0.02), "l" + std::to_string(i));
+  }
+  c.gravity << 0.0, 0.0, 9.81;
+  return c;
+}
+
+template <int NV>
+void check_against_lagrangian(const DynamicChain<double>& chain, int states, double q_scale,
+                              unsigned seed) {
+  ASSERT_EQ(2 * chain.num_coordinates(), NV);
+  const auto chain_ad = chain.cast<softrne_test::ADN<NV>>();
+  auto data = chain.make_data();
+  std::mt19937 rng(seed);
+  const int n = chain.num_coordinates();
+  double worst = 0;
+  for (int s = 0; s < states; ++s) {
+    const VectorXd q = softrne_test::random_vector(rng, n, q_scale);
+    const VectorXd qd = softrne_test::random_vector(rng, n, 2.0);
+    const VectorXd qdd = softrne_test::random_vector(rng, n, 5.0);
+    const VectorXd tau = rnea(chain, data, q, qd, qdd);
+    const VectorXd ref = euler_lagrange(chain_ad, q, qd, qdd);
+    const double e = (tau - ref).norm() / std::max(1e-3, ref.norm());
+    worst = std::max(worst, e);
+    ASSERT_LT(e, 1e-9) << "state " << s << "\nrnea " << tau.transpose() << "\nEL   " << ref.transpose();
+  }
+  std::printf("[ info ] %d coordinates: worst relative |rnea - Euler-Lagrange| = %.2e\n", n, worst);
+}
+
+TEST(RneaLagrangian, CcOnlyChain) { check_against_lagrangian<12>(cc_only(), 100, 1.6, 11); }
+TEST(RneaLagrangian, PaperArm) { check_against_lagrangian<12>(softrne_test::paper_arm(), 100, 1.6, 12); }
+TEST(RneaLagrangian, HybridWithRevoluteJoints) { check_against_lagrangian<12>(hybrid(), 100, 1.6, 13); }
+TEST(RneaLagrangian, LongChain100Segments) { check_against_lagrangian<200>(long_chain(50), 3, 0.3, 14); }
+
+TEST(RneaLagrangian, PaperFrozenInertiaIsNotLagrangian) {
+  // The paper's eq. 18 drops dI/dt: it must differ from Euler-Lagrange at speed (and agree
+  // at rest, where the dropped terms vanish).
+  auto chain = softrne_test::paper_arm();
+  chain.inertia_rate = InertiaRate::PaperFrozen;
+  auto data = chain.make_data();
+  const auto chain_ad = softrne_test::paper_arm().cast<softrne_test::ADN<12>>();
+  std::mt19937 rng(15);
+  const VectorXd q = softrne_test::random_vector(rng, 6, 1.0);
+  const VectorXd qd = softrne_test::random_vector(rng, 6, 2.0);
+  const VectorXd qdd = softrne_test::random_vector(rng, 6, 5.0);
+  const VectorXd ref = euler_lagrange(chain_ad, q, qd, qdd);
+  EXPECT_GT((rnea(chain, data, q, qd, qdd) - ref).norm() / ref.norm(), 1e-6);
+  const VectorXd z = VectorXd::Zero(6);
+  EXPECT_LT((rnea(chain, data, q, z, qdd) - euler_lagrange(chain_ad, q, z, qdd)).norm(), 1e-9);
+}
+
+TEST(RneaIdentities, GravityBiasMassMatrix) {
+  for (const auto& chain : {cc_only(), softrne_test::paper_arm(), hybrid()}) {
+    auto data = chain.make_data();
+    const auto chain_ad = chain.cast<softrne_test::ADN<12>>();
+    const int n = chain.num_coordinates();
+    std::mt19937 rng(21);
+    for (int s = 0; s < 20; ++s) {
+      const VectorXd q = softrne_test::random_vector(rng, n, 1.6);
+      const VectorXd qd = softrne_test::random_vector(rng, n, 2.0);
+      const VectorXd qdd = softrne_test::random_vector(rng, n, 5.0);
+      const VectorXd z = VectorXd::Zero(n);
+      const VectorXd G = gravity(chain, data, q);
+      EXPECT_LT(softrne_test::rel_err(rnea(chain, data, q, z, z), G), 1e-14);
+      const VectorXd Cqd = bias(chain, data, q, qd);
+      EXPECT_LT(softrne_test::rel_err(rnea(chain, data, q, qd, z) - G, Cqd), 1e-13);
+      EXPECT_LT(softrne_test::rel_err(bias(chain, data, q, qd, true), G + Cqd), 1e-13);
+      const MatrixXd M = mass_matrix(chain, data, q);
+      EXPECT_LT(softrne_test::rel_err(M, M.transpose()), 1e-14);
+      EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatrixXd>(M).eigenvalues().minCoeff(), 0.0);
+      EXPECT_LT(softrne_test::rel_err(rnea(chain, data, q, qd, qdd), M * qdd + Cqd + G), 1e-13);
+      mass_matrix_and_bias(chain, data, q, qd);
+      EXPECT_LT(softrne_test::rel_err(data.mass_matrix, M), 1e-15);
+      EXPECT_LT(softrne_test::rel_err(data.bias_forces, Cqd + G), 1e-13);
+      // G = dV/dq.
+      VectorXd a, b, dV;
+      lagrangian_gradients(chain_ad, q, qd, a, b, dV);
+      EXPECT_LT(softrne_test::rel_err(G, dV), 1e-12);
+      // qd^T (dM/dt - 2C) qd = 0 with dM/dt by a central difference along qd.
+      const double eps = 1e-6;
+      const MatrixXd Mp = mass_matrix(chain, data, VectorXd(q + eps * qd));
+      const MatrixXd Mm = mass_matrix(chain, data, VectorXd(q - eps * qd));
+      const double skew = qd.dot((Mp - Mm) / (2 * eps) * qd) - 2 * qd.dot(Cqd);
+      EXPECT_LT(std::abs(skew), 1e-7 * std::max(1.0, std::abs(qd.dot(Cqd))));
+    }
+  }
+}
+
+TEST(RneaIdentities, StaticChainEqualsRuntimeChain) {
+  using CC = ConstantCurvatureJoint<double>;
+  using RL = RigidLink<double>;
+  using RJ = RevoluteJoint<double>;
+  Chain<RJ, RL, CC, RL, RJ, RL, CC, RL> st(
+      softrne_test::revolute<double>(0, 0, 1), softrne_test::paper_link<double>(1.0, 0.1),
+      softrne_test::paper_cc<double>(0.8, 0.2, 0.2), softrne_test::paper_link<double>(1.5, 0.15),
+      softrne_test::revolute<double>(1, 0.2, 0), softrne_test::paper_link<double>(0.7, 0.2),
+      softrne_test::paper_cc<double>(0.4, 0.12, 0.1), softrne_test::paper_link<double>(0.3, 0.05));
+  st.gravity << 0.0, 0.0, -9.81;
+  const auto dyn = hybrid();
+  static_assert(decltype(st)::nq == 6);
+  auto sd = st.make_data();
+  auto dd = dyn.make_data();
+  std::mt19937 rng(31);
+  for (int s = 0; s < 50; ++s) {
+    const VectorXd q = softrne_test::random_vector(rng, 6, 2.0);
+    const VectorXd qd = softrne_test::random_vector(rng, 6, 2.0);
+    const VectorXd qdd = softrne_test::random_vector(rng, 6, 5.0);
+    const Eigen::Matrix<double, 6, 1> qs = q, qds = qd, qdds = qdd;
+    EXPECT_EQ(VectorXd(rnea(st, sd, qs, qds, qdds)), rnea(dyn, dd, q, qd, qdd));
+    EXPECT_EQ(MatrixXd(mass_matrix(st, sd, qs)), mass_matrix(dyn, dd, q));
+  }
+}
+
+TEST(RneaClosedForm, SingleJointWithTipMassStaticEquilibrium) {
+  // A CC joint with gravity sideways (-y) bending about x only, with a point-like tip mass M:
+  // V(u) = g (m r_c,y + M r_e,y), r_e,y = -h (1 - cos u)/u, r_c,y = -h (u - sin u)/u^2, and
+  // the equilibrium k u + dV/du = 0 found here by bisection on that scalar equation.
+  const double m = 0.8, h = 0.2, M = 0.5, k = 6.0, g = 9.81;
+  DynamicChain<double> c;
+  auto cc = softrne_test::paper_cc<double>(m, h, 0.2);
+  c.add(cc, "j");
+  RigidLink<double> tip;
+  tip.mass = M;
+  tip.inertia = Eigen::Matrix3d::Identity() * 1e-12;
+  c.add(tip, "tip");
+  c.gravity << 0, -g, 0;
+  auto dVdu = [&](double u) {
+    const double s = std::sin(u), co = std::cos(u);
+    const double drc = -h * ((1 - co) / (u * u) - 2 * (u - s) / (u * u * u));
+    const double dre = -h * (s / u - (1 - co) / (u * u));
+    return g * (m * drc + M * dre);
+  };
+  double lo = 0.01, hi = 3.0;
+  auto f = [&](double u) { return k * u + dVdu(u); };
+  ASSERT_LT(f(lo) * f(hi), 0.0);
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (f(lo) * f(mid) <= 0 ? hi : lo) = mid;
+  }
+  const double u_star = 0.5 * (lo + hi);
+  EXPECT_GT(u_star, 0.1);
+  auto data = c.make_data();
+  const VectorXd q = (VectorXd(2) << u_star, 0.0).finished();
+  const VectorXd G = gravity(c, data, q);
+  EXPECT_NEAR(G(0) + k * u_star, 0.0, 1e-12);
+  EXPECT_NEAR(G(1), 0.0, 1e-12);
+  std::printf("[ info ] equilibrium u* = %.6f rad, residual %.2e N m\n", u_star, G(0) + k * u_star);
+}
+
+TEST(RneaAllocation, StaticChainAlgorithmsDoNotAllocate) {
+  using CC = ConstantCurvatureJoint<double>;
+  using RL = RigidLink<double>;
+  Chain<CC, RL, CC, RL, CC, RL> arm(softrne_test::paper_cc<double>(), softrne_test::paper_link<double>(),
+                                    softrne_test::paper_cc<double>(), softrne_test::paper_link<double>(),
+                                    softrne_test::paper_cc<double>(), softrne_test::paper_link<double>());
+  auto data = arm.make_data();
+  Eigen::Matrix<double, 6, 1> q, qd, qdd;
+  q << 0.1, 0.2, -0.3, 0.4, 0.5, -0.6;
+  qd << 1, 2, 3, -1, -2, -3;
+  qdd.setOnes();
+  Eigen::internal::set_is_malloc_allowed(false);
+  rnea(arm, data, q, qd, qdd);
+  gravity(arm, data, q);
+  bias(arm, data, q, qd);
+  mass_matrix(arm, data, q);
+  mass_matrix_and_bias(arm, data, q, qd);
+  Eigen::internal::set_is_malloc_allowed(true);
+  SUCCEED();
+}
+
+TEST(RneaAllocation, RuntimeChainAlgorithmsDoNotAllocateAfterMakeData) {
+  const auto chain = softrne_test::paper_arm();
+  auto data = chain.make_data();
+  const VectorXd q = VectorXd::Constant(6, 0.3), qd = VectorXd::Constant(6, -0.5),
+                 qdd = VectorXd::Ones(6);
+  Eigen::internal::set_is_malloc_allowed(false);
+  rnea(chain, data, q, qd, qdd);
+  mass_matrix_and_bias(chain, data, q, qd);
+  Eigen::internal::set_is_malloc_allowed(true);
+  SUCCEED();
+}
+
+}  // namespace
