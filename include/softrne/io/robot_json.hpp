@@ -1,0 +1,550 @@
+#pragma once
+/// \file
+/// \brief Read and write `robot.json` (format `softrne-robot/1`,
+/// shared/spec/formats.md section 1), with strict validation: every problem is
+/// an InputError with a one-line message naming the file, the segment and the field.
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "softrne/io/errors.hpp"
+#include "softrne/io/robot_spec.hpp"
+#include "softrne/io/robot_validate.hpp"
+
+namespace softrne::io {
+
+/// \brief The format string this reader and writer know.
+inline constexpr const char* kRobotFormat = "softrne-robot/1";
+
+namespace detail {
+
+/// \brief Levenshtein distance, for "did you mean" hints.
+inline std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      cur[j] =
+          std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0u : 1u)});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+/// \brief "; allowed: a, b, c" or "; did you mean 'mass'?".
+inline std::string suggest(const std::string& key, const std::vector<std::string>& allowed) {
+  std::size_t best = std::numeric_limits<std::size_t>::max();
+  std::string best_name;
+  for (const auto& a : allowed) {
+    const std::size_t d = edit_distance(key, a);
+    if (d < best) best = d, best_name = a;
+  }
+  if (!best_name.empty() && best <= std::max<std::size_t>(2, key.size() / 3))
+    return "; did you mean '" + best_name + "'?";
+  std::string s = "; allowed: ";
+  for (std::size_t i = 0; i < allowed.size(); ++i) s += (i ? ", " : "") + allowed[i];
+  return s;
+}
+
+/// \brief A short one-line rendering of a JSON value for messages.
+inline std::string describe(const nlohmann::json& v) {
+  if (v.is_null()) return "null";
+  std::string d;
+  try {
+    d = v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  } catch (...) {
+    d = "?";
+  }
+  if (d.size() > 40) d = d.substr(0, 40) + "...";
+  return std::string(v.type_name()) + " " + one_line(d);
+}
+
+/// \brief Reads fields of one JSON object, with errors that name source and place.
+class ObjectReader {
+ public:
+  ObjectReader(const nlohmann::json& obj, const std::string& source, std::string where)
+      : obj_(obj), source_(source), where_(std::move(where)) {}
+
+  const std::string& where() const { return where_; }
+  void set_where(std::string w) { where_ = std::move(w); }
+
+  /// Throw UnknownField on the first key not in `allowed`.
+  void only(const std::vector<std::string>& allowed) const {
+    for (auto it = obj_.begin(); it != obj_.end(); ++it) {
+      if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
+        throw InputError(Category::UnknownField, source_, where_,
+                         "unknown field " + quoted(it.key()) + suggest(it.key(), allowed));
+    }
+  }
+
+  bool has(const char* key) const { return obj_.contains(key); }
+
+  const nlohmann::json& at(const char* key) const {
+    const auto it = obj_.find(key);
+    if (it == obj_.end())
+      throw InputError(Category::MissingField, source_, fw(key), "missing (required)");
+    return *it;
+  }
+
+  double number(const char* key) const { return as_number(at(key), fw(key)); }
+
+  std::string string(const char* key) const {
+    const auto& v = at(key);
+    if (!v.is_string())
+      throw InputError(Category::WrongType, source_, fw(key),
+                       "expected a string, got " + describe(v));
+    return v.get<std::string>();
+  }
+
+  std::string optional_string(const char* key, std::string fallback) const {
+    return has(key) ? string(key) : fallback;
+  }
+
+  int integer(const char* key) const {
+    const auto& v = at(key);
+    if (!v.is_number_integer())
+      throw InputError(Category::WrongType, source_, fw(key),
+                       "expected an integer, got " + describe(v));
+    if (v.is_number_unsigned()) {
+      const auto u = v.get<std::uint64_t>();
+      if (u > static_cast<std::uint64_t>(std::numeric_limits<int>::max()))
+        throw InputError(Category::OutOfRange, source_, fw(key),
+                         "too large (got " + std::to_string(u) + ")");
+      return static_cast<int>(u);
+    }
+    const auto i = v.get<std::int64_t>();
+    if (i < std::numeric_limits<int>::min() || i > std::numeric_limits<int>::max())
+      throw InputError(Category::OutOfRange, source_, fw(key),
+                       "out of range (got " + std::to_string(i) + ")");
+    return static_cast<int>(i);
+  }
+
+  /// A JSON array of exactly N numbers.
+  template <int N>
+  Eigen::Matrix<double, N, 1> fixed(const char* key) const {
+    const auto& v = at(key);
+    const std::string w = fw(key);
+    check_array(v, w, N);
+    Eigen::Matrix<double, N, 1> out;
+    for (int i = 0; i < N; ++i)
+      out[i] = as_number(v[static_cast<std::size_t>(i)], w + "[" + std::to_string(i) + "]", w, i);
+    return out;
+  }
+
+  /// A JSON array (any length) of strings.
+  std::vector<std::string> strings(const char* key) const {
+    const auto& v = at(key);
+    const std::string w = fw(key);
+    if (!v.is_array())
+      throw InputError(Category::WrongType, source_, w,
+                       "expected an array of strings, got " + describe(v));
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_string())
+        throw InputError(
+            Category::WrongType, source_, w,
+            "element " + std::to_string(i) + ": expected a string, got " + describe(v[i]));
+      out.push_back(v[i].get<std::string>());
+    }
+    return out;
+  }
+
+  std::string fw(const std::string& key) const { return field_where(where_, key); }
+
+  void check_array(const nlohmann::json& v, const std::string& w, int n) const {
+    if (!v.is_array())
+      throw InputError(
+          Category::WrongType, source_, w,
+          "expected an array of " + std::to_string(n) + " numbers, got " + describe(v));
+    if (v.size() != static_cast<std::size_t>(n))
+      throw InputError(
+          Category::BadShape, source_, w,
+          "expected " + std::to_string(n) + " numbers, got " + std::to_string(v.size()));
+  }
+
+  double as_number(const nlohmann::json& v, const std::string& w, const std::string& array_w = "",
+                   int element = -1) const {
+    if (!v.is_number()) {
+      if (element >= 0)
+        throw InputError(
+            Category::WrongType, source_, array_w,
+            "element " + std::to_string(element) + ": expected a number, got " + describe(v));
+      throw InputError(Category::WrongType, source_, w, "expected a number, got " + describe(v));
+    }
+    const double d = v.get<double>();
+    if (!std::isfinite(d))
+      throw InputError(Category::NonFinite, source_, w, "must be a finite number");
+    return d;
+  }
+
+ private:
+  const nlohmann::json& obj_;
+  const std::string& source_;
+  std::string where_;
+};
+
+inline void require_object(const nlohmann::json& v, const std::string& source,
+                           const std::string& where) {
+  if (!v.is_object())
+    throw InputError(Category::WrongType, source, where,
+                     "expected a JSON object, got " + describe(v));
+}
+
+inline CCJointSpec read_cc_joint(const ObjectReader& r, const std::string& source) {
+  r.only({"type", "name", "mass", "height", "diameter", "chamber_distance", "chamber_radius",
+          "stiffness", "damping", "pressure_to_torque", "inertia_model", "quadrature_points"});
+  CCJointSpec j;
+  j.mass = r.number("mass");
+  j.height = r.number("height");
+  j.diameter = r.number("diameter");
+  j.chamber_distance = r.number("chamber_distance");
+  j.chamber_radius = r.number("chamber_radius");
+  j.stiffness = r.fixed<2>("stiffness");
+  j.damping = r.fixed<2>("damping");
+  if (r.has("pressure_to_torque")) {
+    const auto& v = r.at("pressure_to_torque");
+    const std::string w = r.fw("pressure_to_torque");
+    if (!v.is_array() || v.size() != 2 || !v[0].is_array() || !v[1].is_array())
+      throw InputError(v.is_array() ? Category::BadShape : Category::WrongType, source, w,
+                       "expected 2 rows (u, v) of K numbers, [[...], [...]], got " + describe(v));
+    const std::size_t K = v[0].size();
+    if (K < 1 || v[1].size() != K)
+      throw InputError(Category::BadShape, source, w,
+                       "rows must have the same length K >= 1 (got " + std::to_string(v[0].size()) +
+                           " and " + std::to_string(v[1].size()) + ")");
+    j.pressure_to_torque.resize(2, static_cast<Eigen::Index>(K));
+    for (std::size_t row = 0; row < 2; ++row)
+      for (std::size_t k = 0; k < K; ++k)
+        j.pressure_to_torque(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(k)) =
+            r.as_number(v[row][k], r.fw("pressure_to_torque[" + std::to_string(row) + "][" +
+                                        std::to_string(k) + "]"));
+    j.custom_pressure_map = true;
+  } else {
+    j.pressure_to_torque = default_pressure_to_torque(j.chamber_distance, j.chamber_radius);
+  }
+  j.inertia_model = r.optional_string("inertia_model", "lumped");
+  if (r.has("quadrature_points")) j.quadrature_points = r.integer("quadrature_points");
+  return j;
+}
+
+inline RigidLinkSpec read_rigid_link(const ObjectReader& r) {
+  r.only({"type", "name", "mass", "length", "com", "inertia"});
+  RigidLinkSpec l;
+  l.mass = r.number("mass");
+  l.length = r.number("length");
+  l.com = r.fixed<3>("com");
+  const auto a = r.fixed<6>("inertia");
+  l.inertia = inertia_from_array(a[0], a[1], a[2], a[3], a[4], a[5]);
+  return l;
+}
+
+inline RevoluteJointSpec read_revolute_joint(const ObjectReader& r) {
+  r.only({"type", "name", "axis", "stiffness", "damping"});
+  RevoluteJointSpec j;
+  j.axis = r.fixed<3>("axis");
+  j.stiffness = r.number("stiffness");
+  j.damping = r.number("damping");
+  return j;
+}
+
+inline SegmentSpec read_segment(const nlohmann::json& v, std::size_t index,
+                                const std::string& source, const std::string& prefix) {
+  const std::string where0 = segment_where(prefix, index, "");
+  require_object(v, source, where0);
+  ObjectReader r(v, source, where0);
+  const std::string type = r.string("type");
+  static const std::vector<std::string> kTypes = {"cc_joint", "rigid_link", "revolute_joint"};
+  if (std::find(kTypes.begin(), kTypes.end(), type) == kTypes.end())
+    throw InputError(Category::UnknownType, source, r.fw("type"),
+                     "unknown segment type " + quoted(type) + suggest(type, kTypes));
+  const std::string name = r.optional_string("name", type + std::to_string(index));
+  r.set_where(segment_where(prefix, index, name));
+  SegmentSpec s;
+  if (type == "cc_joint") {
+    CCJointSpec j = read_cc_joint(r, source);
+    j.name = name;
+    s = std::move(j);
+  } else if (type == "rigid_link") {
+    RigidLinkSpec l = read_rigid_link(r);
+    l.name = name;
+    s = std::move(l);
+  } else {
+    RevoluteJointSpec j = read_revolute_joint(r);
+    j.name = name;
+    s = std::move(j);
+  }
+  validate_segment(s, index, source, prefix);
+  return s;
+}
+
+inline EffectSpec read_effect(const nlohmann::json& v, std::size_t index, const std::string& source,
+                              const std::string& prefix) {
+  const std::string where0 = effect_where(prefix, index, "");
+  require_object(v, source, where0);
+  ObjectReader r(v, source, where0);
+  EffectSpec e;
+  e.name = r.string("name");
+  r.set_where(effect_where(prefix, index, e.name));
+  r.only({"name", "joints", "params", "evidence"});
+  if (r.has("joints")) e.joints = r.strings("joints");
+  if (r.has("params")) {
+    const auto& p = r.at("params");
+    if (!p.is_object())
+      throw InputError(Category::WrongType, source, r.fw("params"),
+                       "expected an object of numbers, got " + describe(p));
+    for (auto it = p.begin(); it != p.end(); ++it)
+      e.params[it.key()] = r.as_number(it.value(), r.fw("params." + it.key()));
+  }
+  e.evidence = r.optional_string("evidence", "");
+  return e;
+}
+
+/// \brief Parse with duplicate-key detection (nlohmann keeps the last silently).
+inline nlohmann::json parse_json_strict(const std::string& text, const std::string& source) {
+  struct Frame {
+    explicit Frame(bool array) : is_array(array) {}
+    bool is_array;
+    std::size_t index = 0;
+    std::string last_key;
+    std::vector<std::string> keys;
+  };
+  std::vector<Frame> stack;
+  // Location of the innermost object or array (with_last: of the value being read in it).
+  auto path = [&stack](bool with_last = false) {
+    std::string p;
+    for (std::size_t i = 0; i + (with_last ? 0 : 1) < stack.size(); ++i) {
+      const Frame& f = stack[i];
+      if (f.is_array)
+        p += "[" + std::to_string(f.index) + "]";
+      else
+        p += (p.empty() ? "" : ".") + f.last_key;
+    }
+    return p;
+  };
+  auto element_done = [&stack]() {
+    if (!stack.empty() && stack.back().is_array) ++stack.back().index;
+  };
+  using Event = nlohmann::json::parse_event_t;
+  nlohmann::json::parser_callback_t cb = [&](int /*depth*/, Event event,
+                                             nlohmann::json& parsed) -> bool {
+    switch (event) {
+      case Event::object_start:
+        stack.emplace_back(false);
+        break;
+      case Event::array_start:
+        stack.emplace_back(true);
+        break;
+      case Event::key: {
+        Frame& f = stack.back();
+        const std::string key = parsed.get<std::string>();
+        if (std::find(f.keys.begin(), f.keys.end(), key) != f.keys.end()) {
+          const std::string p = path();
+          throw InputError(Category::DuplicateField, source, p.empty() ? "top level" : p,
+                           "key " + quoted(key) + " appears twice in the same object");
+        }
+        f.keys.push_back(key);
+        f.last_key = key;
+        break;
+      }
+      case Event::object_end:
+      case Event::array_end:
+        stack.pop_back();
+        element_done();
+        break;
+      case Event::value:
+        element_done();
+        break;
+    }
+    return true;
+  };
+  std::size_t first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) throw InputError(Category::Empty, source, "", "empty file");
+  try {
+    return nlohmann::json::parse(text, cb);
+  } catch (const nlohmann::json::parse_error& e) {
+    // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error while ..."
+    std::string msg = e.what();
+    std::string where = "byte " + std::to_string(e.byte);
+    const std::size_t p = msg.find("parse error");
+    if (p != std::string::npos) {
+      msg = msg.substr(p);
+      const std::size_t colon = msg.find(": ");
+      if (colon != std::string::npos) {
+        const std::string head = msg.substr(0, colon);
+        msg = msg.substr(colon + 2);
+        const std::size_t at = head.find(" at ");
+        if (at != std::string::npos) where = head.substr(at + 4);
+      }
+      // nlohmann quotes all it has read of the current token: keep the end of long ones.
+      const std::size_t lr = msg.find("last read: '");
+      if (lr != std::string::npos) {
+        const std::size_t b = lr + 12;
+        std::size_t e2 = msg.find("'; ", b);
+        if (e2 == std::string::npos) e2 = msg.size() - 1;
+        if (e2 > b + 40) msg = msg.substr(0, b) + "..." + msg.substr(e2 - 37);
+      }
+    }
+    throw InputError(Category::Syntax, source, where, "JSON " + msg);
+  } catch (const nlohmann::json::out_of_range& e) {
+    std::string msg = e.what();
+    const std::size_t p = msg.find("] ");
+    if (p != std::string::npos) msg = msg.substr(p + 2);
+    throw InputError(Category::NonFinite, source, path(true), msg);
+  }
+}
+
+template <class Json>
+Json to_json_impl(const RobotSpec& robot) {
+  auto vec = [](const auto& v) {
+    Json a = Json::array();
+    for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
+    return a;
+  };
+  Json j = Json::object();
+  j["format"] = kRobotFormat;
+  j["name"] = robot.name;
+  j["gravity"] = vec(robot.gravity);
+  Json segs = Json::array();
+  for (const auto& s : robot.segments) {
+    Json o = Json::object();
+    o["type"] = segment_type(s);
+    o["name"] = segment_name(s);
+    if (const auto* c = std::get_if<CCJointSpec>(&s)) {
+      o["mass"] = c->mass;
+      o["height"] = c->height;
+      o["diameter"] = c->diameter;
+      o["chamber_distance"] = c->chamber_distance;
+      o["chamber_radius"] = c->chamber_radius;
+      o["stiffness"] = vec(c->stiffness);
+      o["damping"] = vec(c->damping);
+      if (c->custom_pressure_map) {
+        Json rows = Json::array();
+        for (Eigen::Index r = 0; r < 2; ++r) rows.push_back(vec(c->pressure_to_torque.row(r)));
+        o["pressure_to_torque"] = rows;
+      }
+      if (c->inertia_model != "lumped") o["inertia_model"] = c->inertia_model;
+      if (c->quadrature_points != 0) o["quadrature_points"] = c->quadrature_points;
+    } else if (const auto* l = std::get_if<RigidLinkSpec>(&s)) {
+      o["mass"] = l->mass;
+      o["length"] = l->length;
+      o["com"] = vec(l->com);
+      o["inertia"] = vec(inertia_to_array(l->inertia));
+    } else if (const auto* r = std::get_if<RevoluteJointSpec>(&s)) {
+      o["axis"] = vec(r->axis);
+      o["stiffness"] = r->stiffness;
+      o["damping"] = r->damping;
+    }
+    segs.push_back(std::move(o));
+  }
+  j["segments"] = std::move(segs);
+  if (!robot.effects.empty()) {
+    Json effs = Json::array();
+    for (const auto& e : robot.effects) {
+      Json o = Json::object();
+      o["name"] = e.name;
+      o["joints"] = e.joints;
+      Json params = Json::object();
+      for (const auto& [k, v] : e.params) params[k] = v;
+      o["params"] = std::move(params);
+      o["evidence"] = e.evidence;
+      effs.push_back(std::move(o));
+    }
+    j["effects"] = std::move(effs);
+  }
+  return j;
+}
+
+}  // namespace detail
+
+/// \brief Build a RobotSpec from parsed JSON (e.g. a report's `fitted_robot`).
+/// \param source file name for messages; \param prefix location prefix such as "fitted_robot."
+inline RobotSpec robot_from_json(const nlohmann::json& j, const std::string& source,
+                                 const std::string& prefix = "") {
+  const std::string top =
+      prefix.empty() ? "top level" : prefix.substr(0, prefix.size() - (prefix.back() == '.'));
+  detail::require_object(j, source, top);
+  detail::ObjectReader r(j, source, prefix.empty() ? "" : top);
+  // The version first: a file of another format gets that error, not a list of unknown fields.
+  const auto it = j.find("format");
+  if (it == j.end())
+    throw InputError(Category::MissingField, source, r.fw("format"),
+                     std::string("missing; a robot description starts with \"format\": \"") +
+                         kRobotFormat + "\"");
+  const std::string format = r.string("format");
+  if (format != kRobotFormat) {
+    std::string hint;
+    if (format == "softrne-loop-report/1")
+      hint = " (this is a loop report; its robot is the field 'fitted_robot')";
+    throw InputError(
+        Category::UnknownFormat, source, r.fw("format"),
+        "unknown format " + detail::quoted(format) + ", expected '" + kRobotFormat + "'" + hint);
+  }
+  r.only({"format", "name", "gravity", "segments", "effects"});
+  RobotSpec robot;
+  robot.source = source;
+  robot.name = r.optional_string("name", "");
+  robot.gravity = r.fixed<3>("gravity");
+  const auto& segs = r.at("segments");
+  if (!segs.is_array())
+    throw InputError(Category::WrongType, source, r.fw("segments"),
+                     "expected an array of segments, got " + detail::describe(segs));
+  if (segs.empty())
+    throw InputError(Category::Empty, source, r.fw("segments"), "must hold at least one segment");
+  for (std::size_t i = 0; i < segs.size(); ++i)
+    robot.segments.push_back(detail::read_segment(segs[i], i, source, prefix));
+  if (r.has("effects")) {
+    const auto& effs = r.at("effects");
+    if (!effs.is_array())
+      throw InputError(Category::WrongType, source, r.fw("effects"),
+                       "expected an array of effects, got " + detail::describe(effs));
+    for (std::size_t i = 0; i < effs.size(); ++i)
+      robot.effects.push_back(detail::read_effect(effs[i], i, source, prefix));
+  }
+  detail::validate_robot_global(robot, source, prefix);
+  return robot;
+}
+
+/// \brief Parse the text of a `robot.json`; `source_name` names it in messages.
+inline RobotSpec parse_robot_json(const std::string& text, const std::string& source_name) {
+  return robot_from_json(detail::parse_json_strict(text, source_name), source_name);
+}
+
+/// \brief Read and validate a `robot.json` file.
+inline RobotSpec read_robot_json(const std::string& path) {
+  return parse_robot_json(detail::read_text_file(path), path);
+}
+
+/// \brief The `softrne-robot/1` JSON of a robot (keys sorted, as nlohmann::json does).
+inline nlohmann::json to_json(const RobotSpec& robot) {
+  return detail::to_json_impl<nlohmann::json>(robot);
+}
+
+/// \brief The `softrne-robot/1` JSON of a robot with keys in the documented order.
+inline nlohmann::ordered_json to_ordered_json(const RobotSpec& robot) {
+  return detail::to_json_impl<nlohmann::ordered_json>(robot);
+}
+
+/// \brief Validate `robot` and write it as `softrne-robot/1` (2-space indent, keys
+/// in the documented order, doubles in shortest round-trip form: reading the file
+/// back gives bit-identical numbers). Throws InputError (WriteFailed, or the
+/// validation error, with source "<path> (writing)").
+inline void write_robot_json(const RobotSpec& robot, const std::string& path) {
+  const std::string src = path + " (writing)";
+  for (std::size_t i = 0; i < robot.segments.size(); ++i)
+    detail::validate_segment(robot.segments[i], i, src);
+  detail::validate_robot_global(robot, src);
+  detail::write_text_file(path, to_ordered_json(robot).dump(2) + "\n");
+}
+
+}  // namespace softrne::io
