@@ -1,0 +1,183 @@
+// Self-containment of the header is checked by tests/headers.
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "softrne/sim/input_signal.hpp"
+
+namespace {
+
+using softrne::sim::InputSignal;
+using softrne::sim::Interpolation;
+using softrne::sim::Side;
+using softrne::sim::SignalCursor;
+
+// Irregular times, two channels: channel 0 = 10 * i, channel 1 = a ramp with a repeat.
+InputSignal make_signal(Interpolation interp) {
+  Eigen::VectorXd t(5);
+  t << 0.0, 0.1, 0.35, 0.4, 1.0;
+  Eigen::MatrixXd u(5, 2);
+  u << 0, 5,  //
+      10, 5,  //
+      20, 7,  //
+      30, 7,  //
+      40, 9;
+  return InputSignal(t, u, interp);
+}
+
+// Reference: straightforward linear scan.
+Eigen::Vector2d reference(const InputSignal& s, double t, Side side) {
+  const Eigen::VectorXd& ts = s.times();
+  const Eigen::Index n = ts.size();
+  if (s.interpolation() == Interpolation::zero_order_hold) {
+    Eigen::Index i = 0;
+    for (Eigen::Index k = 0; k < n; ++k)
+      if (side == Side::right ? ts[k] <= t : ts[k] < t) i = k;
+    return s.sample(i);
+  }
+  if (t <= ts[0]) return s.sample(0);
+  if (t >= ts[n - 1]) return s.sample(n - 1);
+  Eigen::Index i = 0;
+  while (ts[i + 1] <= t) ++i;
+  const double a = (t - ts[i]) / (ts[i + 1] - ts[i]);
+  return (1 - a) * s.sample(i) + a * s.sample(i + 1);
+}
+
+TEST(InputSignal, ZeroOrderHoldValuesAndClamping) {
+  InputSignal s = make_signal(Interpolation::zero_order_hold);
+  ASSERT_EQ(s.size(), 2);
+  ASSERT_EQ(s.num_samples(), 5);
+  Eigen::Vector2d u;
+  s.value(-3.0, u);
+  EXPECT_EQ(u, Eigen::Vector2d(0, 5));
+  s.value(0.0, u);
+  EXPECT_EQ(u, Eigen::Vector2d(0, 5));
+  s.value(0.0999, u);
+  EXPECT_EQ(u, Eigen::Vector2d(0, 5));
+  s.value(0.1, u);  // right-continuous
+  EXPECT_EQ(u, Eigen::Vector2d(10, 5));
+  s.value(0.1, u, Side::left);  // left limit at a jump
+  EXPECT_EQ(u, Eigen::Vector2d(0, 5));
+  s.value(0.37, u, Side::left);  // off a sample time both sides agree
+  EXPECT_EQ(u, Eigen::Vector2d(20, 7));
+  s.value(1.0, u);
+  EXPECT_EQ(u, Eigen::Vector2d(40, 9));
+  s.value(1.0, u, Side::left);
+  EXPECT_EQ(u, Eigen::Vector2d(30, 7));
+  s.value(7.0, u);
+  EXPECT_EQ(u, Eigen::Vector2d(40, 9));
+}
+
+TEST(InputSignal, LinearValuesAndClamping) {
+  InputSignal s = make_signal(Interpolation::linear);
+  Eigen::Vector2d u;
+  s.value(-1.0, u);
+  EXPECT_EQ(u, Eigen::Vector2d(0, 5));
+  s.value(0.05, u);
+  EXPECT_NEAR(u[0], 5.0, 1e-14);
+  EXPECT_NEAR(u[1], 5.0, 1e-14);
+  s.value(0.225, u);  // halfway between 0.1 and 0.35
+  EXPECT_NEAR(u[0], 15.0, 1e-13);
+  EXPECT_NEAR(u[1], 6.0, 1e-13);
+  s.value(0.7, u);
+  EXPECT_NEAR(u[0], 35.0, 1e-13);
+  EXPECT_NEAR(u[1], 8.0, 1e-13);
+  s.value(0.35, u, Side::left);  // continuous: the side is irrelevant
+  EXPECT_NEAR(u[0], 20.0, 1e-13);
+  s.value(2.0, u);
+  EXPECT_EQ(u, Eigen::Vector2d(40, 9));
+}
+
+TEST(InputSignal, WritesIntoBlocksOfLargerVectors) {
+  InputSignal s = make_signal(Interpolation::zero_order_hold);
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(6, -1.0);
+  s.value(0.36, x.segment(2, 2));
+  EXPECT_EQ(x, (Eigen::VectorXd(6) << -1, -1, 20, 7, -1, -1).finished());
+}
+
+TEST(InputSignal, Breakpoints) {
+  const InputSignal zoh = make_signal(Interpolation::zero_order_hold);
+  // Every sample after the first changes channel 0.
+  EXPECT_EQ(zoh.breakpoints(), (std::vector<double>{0.1, 0.35, 0.4, 1.0}));
+  // Only channel 1 would not jump at 0.1 and 0.4: a tolerance above 10 keeps none.
+  EXPECT_TRUE(zoh.breakpoints(10.5).empty());
+
+  Eigen::VectorXd t(4);
+  t << 0, 1, 2, 3;
+  Eigen::MatrixXd u(4, 1);
+  u << 0, 1, 2, 2;  // slope 1, 1, 0 ; zero outside
+  const InputSignal lin(t, u, Interpolation::linear);
+  EXPECT_EQ(lin.breakpoints(), (std::vector<double>{0.0, 2.0}));
+  const InputSignal zoh2(t, u, Interpolation::zero_order_hold);
+  EXPECT_EQ(zoh2.breakpoints(), (std::vector<double>{1.0, 2.0}));
+}
+
+TEST(InputSignal, RejectsBadData) {
+  Eigen::VectorXd t(3);
+  t << 0, 1, 1;
+  Eigen::MatrixXd u = Eigen::MatrixXd::Zero(3, 1);
+  EXPECT_THROW(InputSignal(t, u), std::invalid_argument);
+  t << 0, 1, 2;
+  EXPECT_THROW(InputSignal(t, Eigen::MatrixXd::Zero(2, 1)), std::invalid_argument);
+  EXPECT_THROW(InputSignal(Eigen::VectorXd(), Eigen::MatrixXd()), std::invalid_argument);
+  u(1, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(InputSignal(t, u), std::invalid_argument);
+}
+
+TEST(InputSignal, SingleSampleIsConstant) {
+  InputSignal s(Eigen::VectorXd::Constant(1, 2.0), Eigen::MatrixXd::Constant(1, 3, 4.0),
+                Interpolation::linear);
+  Eigen::Vector3d u;
+  for (double t : {-1.0, 2.0, 5.0}) {
+    s.value(t, u);
+    EXPECT_EQ(u, Eigen::Vector3d::Constant(4.0));
+  }
+}
+
+// Cursor correctness: monotone sweeps (dense and sparse), random jumps, exact
+// sample times, both sides, both interpolations, against a linear scan.
+TEST(InputSignal, CursorMatchesLinearScanOnRandomQueries) {
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> dt(0.001, 0.1);
+  const int n = 500;
+  Eigen::VectorXd t(n);
+  t[0] = -0.3;
+  for (int i = 1; i < n; ++i) t[i] = t[i - 1] + dt(rng);
+  Eigen::MatrixXd u = Eigen::MatrixXd::Random(n, 2);
+
+  for (Interpolation interp : {Interpolation::zero_order_hold, Interpolation::linear}) {
+    InputSignal s(t, u, interp);
+    std::uniform_real_distribution<double> any(t[0] - 1.0, t[n - 1] + 1.0);
+    std::uniform_int_distribution<int> any_sample(0, n - 1);
+    std::vector<double> queries;
+    // Monotone dense sweep, including every sample time exactly.
+    for (int i = 0; i < n; ++i) {
+      queries.push_back(t[i]);
+      if (i + 1 < n) queries.push_back(0.5 * (t[i] + t[i + 1]));
+    }
+    // Monotone sparse sweep (jumps of many samples).
+    for (double q = t[0] - 0.5; q < t[n - 1] + 0.5; q += 0.37) queries.push_back(q);
+    // Backwards sweep.
+    for (int i = n - 1; i >= 0; i -= 3) queries.push_back(t[i] - 1e-9);
+    // Random, non-monotone, half of them exact sample times.
+    for (int k = 0; k < 4000; ++k) queries.push_back(k % 2 ? any(rng) : t[any_sample(rng)]);
+
+    SignalCursor cursor;
+    Eigen::Vector2d value, value_const;
+    int mismatches = 0;
+    for (double q : queries)
+      for (Side side : {Side::right, Side::left}) {
+        s.value(q, value, side);
+        s.value(q, value_const, cursor, side);
+        const Eigen::Vector2d expected = reference(s, q, side);
+        if ((value - expected).cwiseAbs().maxCoeff() > 1e-14 ||
+            (value_const - expected).cwiseAbs().maxCoeff() > 1e-14)
+          ++mismatches;
+      }
+    EXPECT_EQ(mismatches, 0) << "interpolation " << static_cast<int>(interp);
+  }
+}
+
+}  // namespace
