@@ -1,0 +1,959 @@
+#pragma once
+/// \file
+/// \brief Bounded nonlinear least squares over a residual vector: a seeded
+///        global stage, a projected Levenberg-Marquardt local stage, and an
+///        identifiability analysis at the optimum.
+///
+/// Generic: nothing here knows about robots. The model is a function that
+/// fills a residual vector of fixed length \f$m\f$ for a parameter vector of
+/// length \f$p\f$, and may fail (return false, throw, or produce non-finite
+/// values) for part of the parameter space.
+///
+/// Cost: \f$c(x) = \tfrac12 \sum_k r_k(x)^2\f$. The optimisers work in the
+/// normalised coordinates \f$u \in [0,1]^p\f$ of ParameterSet.
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <iomanip>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/SVD>
+#include <nlopt.h>
+
+#include <softrne/fit/parameters.hpp>
+
+namespace softrne::fit {
+
+/// \brief Fills `r` (already sized to \f$m\f$) for physical parameters
+///        `params`; returns false when the model fails (e.g. the simulation
+///        diverged). Throwing, resizing `r`, or leaving non-finite entries
+///        also counts as a failure.
+using ResidualFn = std::function<bool(const Eigen::VectorXd& params, Eigen::VectorXd& r)>;
+
+/// \brief Makes one independent ResidualFn per worker thread (the model's
+///        workspace is not shared). Each functor must give the same result
+///        for the same parameters whatever it computed before (no warm
+///        starts), or parallel and serial fits differ.
+using ResidualFactory = std::function<ResidualFn()>;
+
+/// \brief Global stage.
+enum class GlobalMethod {
+  /// Screen a seeded, shifted Halton set (plus the initial guess), then
+  /// refine the best few distinct points with short LM runs. Parallel.
+  multistart,
+  /// NLopt NLOPT_GN_CRS2_LM (controlled random search), seeded by nlopt_srand. Serial.
+  crs2_lm,
+  /// NLopt NLOPT_GN_DIRECT_L (deterministic, ignores the seed). Serial.
+  direct_l,
+};
+
+/// \brief Local stage.
+enum class LocalMethod {
+  /// Projected Levenberg-Marquardt on finite-difference Jacobians.
+  levenberg_marquardt,
+  /// NLopt NLOPT_LN_BOBYQA on the cost (half the budget), then LM.
+  bobyqa_then_lm,
+};
+
+/// \brief Settings of the identifiability analysis at the optimum.
+struct IdentifiabilityOptions {
+  /// A parameter is identifiable when its relative std error is below this.
+  double max_relative_std_error = 0.1;
+  /// Singular values of the scaled Jacobian below `null_space_rtol * s_max`
+  /// span the null space.
+  double null_space_rtol = 1e-8;
+  /// Pairs with \f$|\mathrm{corr}|\f$ above this are reported as correlated.
+  double correlation_threshold = 0.95;
+  /// Relative central-difference step on the physical parameters; 0 means
+  /// \f$\epsilon^{1/3} \approx 6\cdot10^{-6}\f$. Raise it (1e-4..1e-3) when
+  /// the residual carries integrator noise.
+  double fd_step = 0.0;
+};
+
+/// \brief Options of fit_least_squares().
+struct FitOptions {
+  /// Seed of the global stage; a fixed seed gives a bit-identical result.
+  unsigned seed = 1;
+  /// Residual evaluations of the global stage; 0 skips it.
+  int global_evals = 200;
+  /// Residual evaluations of the local stage.
+  int local_evals = 400;
+  /// Stop when an accepted step is below `xtol_rel * (|u| + xtol_rel)` (normalised coordinates).
+  double xtol_rel = 1e-6;
+  /// Stop when an accepted step lowers the cost by less than `ftol_rel * cost`
+  /// (and the model predicted no more).
+  double ftol_rel = 1e-10;
+  /// Worker threads for independent evaluations (multistart points and
+  /// starts, Jacobian columns). Used only by the ResidualFactory overload.
+  int threads = 1;
+  /// Wall-clock limit for the whole fit in seconds; 0 means none.
+  double max_wall_seconds = 0.0;
+  /// Called from the calling thread with (evaluations so far, best cost).
+  std::function<void(int evals, double best_cost)> progress;
+
+  GlobalMethod global_method = GlobalMethod::multistart;
+  /// Multistart: number of distinct starts refined after screening.
+  int multistart_starts = 4;
+  LocalMethod local_method = LocalMethod::levenberg_marquardt;
+  /// Central instead of forward differences in the LM Jacobian.
+  bool central_differences = false;
+  /// Finite-difference step in normalised coordinates; 0 means 1e-6
+  /// (forward) or 1e-5 (central).
+  double fd_step = 0.0;
+  /// Run the identifiability analysis (2p extra evaluations).
+  bool compute_identifiability = true;
+  IdentifiabilityOptions identifiability;
+};
+
+/// \brief Outcome of fit_least_squares().
+///
+/// Never holds NaN. Infinite values mean "unbounded / unavailable": `cost`
+/// when no valid point was found, `std_errors` of parameters in the
+/// null space, `condition_number` of a rank-deficient Jacobian, and the
+/// covariance when \f$m \le p\f$.
+struct FitResult {
+  Eigen::VectorXd params;    ///< physical values at the optimum
+  Eigen::VectorXd residual;  ///< r(params); empty when no valid point was found
+  double cost = std::numeric_limits<double>::infinity();  ///< \f$\tfrac12\sum r^2\f$
+  double rms = std::numeric_limits<double>::infinity();   ///< \f$\sqrt{\sum r^2/m}\f$
+  int evaluations = 0;                                    ///< residual calls, all stages
+  int failed_evaluations = 0;                             ///< calls that failed
+  bool converged = false;  ///< the local stage met xtol_rel or ftol_rel
+  std::string message;     ///< what each stage did, and notes
+  /// \f$s^2 (J^T J)^{+}\f$, \f$s^2 = 2c/(m-p)\f$, J w.r.t. physical parameters.
+  Eigen::MatrixXd covariance;
+  Eigen::VectorXd std_errors;           ///< sqrt(diag(covariance)); inf in the null space
+  Eigen::VectorXd relative_std_errors;  ///< std_errors / max(|x|, 1e-3 (upper - lower))
+  Eigen::MatrixXd correlation;          ///< from the pseudo-inverse covariance
+  Eigen::VectorXd singular_values;      ///< of J scaled by parameter magnitude
+  double condition_number = std::numeric_limits<double>::infinity();  ///< of the scaled J
+  std::vector<bool> identifiable;
+  std::string identifiability_report;  ///< human-readable lines
+};
+
+namespace detail {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Optional wall-clock deadline shared by all stages.
+struct Deadline {
+  bool active = false;
+  Clock::time_point end{};
+  bool passed() const { return active && Clock::now() >= end; }
+  double remaining_seconds() const {
+    return active ? std::chrono::duration<double>(end - Clock::now()).count() : kInf;
+  }
+};
+
+/// One residual functor with its counters; used by one thread at a time.
+class Evaluator {
+ public:
+  Evaluator(const ParameterSet& ps, int m, ResidualFn fn) : ps_(&ps), m_(m), fn_(std::move(fn)) {}
+
+  /// Residual at physical `x`; false (and counted) on any failure.
+  bool physical(const Eigen::VectorXd& x, Eigen::VectorXd& r) {
+    ++evaluations;
+    bool ok = false;
+    r.resize(m_);
+    try {
+      ok = fn_ && fn_(x, r);
+    } catch (...) {
+      ok = false;
+    }
+    if (ok && (r.size() != m_ || !r.allFinite())) ok = false;
+    if (!ok) ++failures;
+    return ok;
+  }
+  /// Residual at normalised `u`.
+  bool normalised(const Eigen::VectorXd& u, Eigen::VectorXd& r) {
+    return physical(ps_->to_physical(u), r);
+  }
+  const ParameterSet& parameters() const { return *ps_; }
+  int residual_size() const { return m_; }
+
+  int evaluations = 0;
+  int failures = 0;
+
+ private:
+  const ParameterSet* ps_;
+  int m_;
+  ResidualFn fn_;
+};
+
+/// Runs batches of independent tasks, task k writing only its own outputs.
+/// Worker w always uses evaluator w, so no functor is shared between threads.
+class Runner {
+ public:
+  explicit Runner(std::vector<Evaluator*> evaluators) : evaluators_(std::move(evaluators)) {}
+
+  Evaluator& main() { return *evaluators_.front(); }
+  int evaluations() const {
+    int n = 0;
+    for (const Evaluator* e : evaluators_) n += e->evaluations;
+    return n;
+  }
+  int failures() const {
+    int n = 0;
+    for (const Evaluator* e : evaluators_) n += e->failures;
+    return n;
+  }
+
+  void run(int n, const std::function<void(int task, Evaluator& ev)>& task) {
+    const int workers = std::min<int>(static_cast<int>(evaluators_.size()), n);
+    if (workers <= 1) {
+      for (int k = 0; k < n; ++k) task(k, main());
+      return;
+    }
+    std::atomic<int> next{0};
+    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(workers));
+    auto work = [&](int w) {
+      try {
+        for (int k = next++; k < n; k = next++) task(k, *evaluators_[w]);
+      } catch (...) {
+        errors[w] = std::current_exception();
+        next = n;  // stop handing out tasks
+      }
+    };
+    std::vector<std::thread> pool;
+    pool.reserve(static_cast<std::size_t>(workers - 1));
+    for (int w = 1; w < workers; ++w) {
+      try {
+        pool.emplace_back(work, w);
+      } catch (...) {
+        break;  // could not start a thread: the others take its share
+      }
+    }
+    work(0);
+    for (std::thread& th : pool) th.join();
+    for (const std::exception_ptr& e : errors)
+      if (e) std::rethrow_exception(e);
+  }
+
+ private:
+  std::vector<Evaluator*> evaluators_;
+};
+
+inline double half_squared_norm(const Eigen::VectorXd& r) {
+  return 0.5 * r.squaredNorm();
+}
+
+/// Forward (or central) differences of r(u) in normalised coordinates,
+/// stepping inside [0,1] and falling back to the other side when an
+/// evaluation fails. Columns that cannot be formed are zero, `column_ok` false.
+inline void jacobian_normalised(Runner& runner, const Eigen::VectorXd& u, const Eigen::VectorXd& r,
+                                double h, bool central, Eigen::MatrixXd& J,
+                                std::vector<char>& column_ok) {
+  const int p = static_cast<int>(u.size());
+  J.resize(r.size(), p);
+  column_ok.assign(static_cast<std::size_t>(p), 0);
+  runner.run(p, [&](int k, Evaluator& ev) {
+    Eigen::VectorXd v = u, r_plus, r_minus;
+    auto eval_at = [&](double uk, Eigen::VectorXd& out) {
+      v[k] = uk;
+      return ev.normalised(v, out);
+    };
+    const double up = u[k] + h, down = u[k] - h;
+    const bool up_inside = up <= 1.0, down_inside = down >= 0.0;
+    bool ok = false;
+    if (central && up_inside && down_inside) {
+      const bool a = eval_at(up, r_plus), b = eval_at(down, r_minus);
+      if (a && b) {
+        J.col(k) = (r_plus - r_minus) / (up - down);
+        ok = true;
+      } else if (a) {
+        J.col(k) = (r_plus - r) / (up - u[k]);
+        ok = true;
+      } else if (b) {
+        J.col(k) = (r - r_minus) / (u[k] - down);
+        ok = true;
+      }
+    } else {
+      const double first = up_inside ? 1.0 : -1.0;
+      for (const double dir : {first, -first}) {
+        if (!(dir > 0 ? up_inside : down_inside)) continue;
+        const double uk = dir > 0 ? up : down;
+        if (eval_at(uk, r_plus)) {
+          J.col(k) = (r_plus - r) / (uk - u[k]);
+          ok = true;
+          break;
+        }
+      }
+    }
+    if (!ok) J.col(k).setZero();
+    column_ok[k] = ok ? 1 : 0;
+  });
+}
+
+struct LmSettings {
+  int max_evals = 400;
+  double xtol_rel = 1e-6;
+  double ftol_rel = 1e-10;
+  bool central = false;
+  double fd_step = 1e-6;
+  const Deadline* deadline = nullptr;
+  std::function<void(double cost)> on_accept;  // progress; main thread only
+};
+
+struct LmOutcome {
+  Eigen::VectorXd u, r;
+  double cost = kInf;
+  bool valid = false;  // u is a point where the residual succeeded
+  bool converged = false;
+  int iterations = 0;
+  std::string message;
+};
+
+/// \brief Projected Levenberg-Marquardt in normalised coordinates (box [0,1]^p).
+///
+/// Step: \f$(J_F^T J_F + \lambda D_F)\,\delta_F = -g_F\f$ over the free set F
+/// (variables not held at a bound by the gradient), \f$D\f$ the running
+/// maximum of diag(\f$J^TJ\f$) (Moré 1978), projected onto the box. Gain-ratio
+/// acceptance and the \f$\lambda\f$ update of Nielsen (1999).
+inline LmOutcome levenberg_marquardt(Runner& runner, const Eigen::VectorXd& u0,
+                                     const LmSettings& s) {
+  LmOutcome out;
+  const int p = static_cast<int>(u0.size());
+  const int start = runner.evaluations();
+  auto used = [&] { return runner.evaluations() - start; };
+  const int jacobian_cost = s.central ? 2 * p : p;
+
+  Eigen::VectorXd u = u0, r;
+  out.u = u0;
+  if (!runner.main().normalised(u, r)) {
+    out.message = "the residual fails at the starting point";
+    return out;
+  }
+  double cost = half_squared_norm(r);
+  out.valid = true;
+
+  Eigen::MatrixXd J, A;
+  Eigen::VectorXd g, D = Eigen::VectorXd::Zero(p), u_new, r_new, step;
+  std::vector<char> column_ok;
+  double lambda = 1e-3, nu = 2.0;
+  bool done = false;
+  while (!done) {
+    if (cost == 0.0) {
+      out.converged = true;
+      out.message = "zero residual";
+      break;
+    }
+    if (used() + jacobian_cost + 1 > s.max_evals) {
+      out.message = "evaluation budget exhausted";
+      break;
+    }
+    if (s.deadline && s.deadline->passed()) {
+      out.message = "wall-clock limit reached";
+      break;
+    }
+    jacobian_normalised(runner, u, r, s.fd_step, s.central, J, column_ok);
+    ++out.iterations;
+    g.noalias() = J.transpose() * r;
+    A.noalias() = J.transpose() * J;
+    D = D.cwiseMax(A.diagonal());
+    const double d_floor = 1e-12 * std::max(D.maxCoeff(), std::numeric_limits<double>::min());
+    const Eigen::VectorXd D_used = D.cwiseMax(d_floor);
+
+    // Free set: a variable on a bound whose gradient pushes it outwards is held.
+    std::vector<int> free_set;
+    for (int i = 0; i < p; ++i) {
+      const bool held = (u[i] <= 0.0 && g[i] > 0.0) || (u[i] >= 1.0 && g[i] < 0.0);
+      if (!held) free_set.push_back(i);
+    }
+    double free_gradient = 0.0;
+    for (const int i : free_set) free_gradient = std::max(free_gradient, std::abs(g[i]));
+    if (free_gradient == 0.0) {
+      out.converged = true;
+      out.message = "projected gradient is zero";
+      break;
+    }
+    const int nf = static_cast<int>(free_set.size());
+    Eigen::MatrixXd A_free(nf, nf);
+    Eigen::VectorXd g_free(nf), d_free(nf);
+    for (int a = 0; a < nf; ++a) {
+      g_free[a] = g[free_set[a]];
+      d_free[a] = D_used[free_set[a]];
+      for (int b = 0; b < nf; ++b) A_free(a, b) = A(free_set[a], free_set[b]);
+    }
+
+    for (;;) {  // inner loop: find an acceptable step for this Jacobian
+      if (used() >= s.max_evals) {
+        out.message = "evaluation budget exhausted";
+        done = true;
+        break;
+      }
+      if (s.deadline && s.deadline->passed()) {
+        out.message = "wall-clock limit reached";
+        done = true;
+        break;
+      }
+      Eigen::MatrixXd M = A_free;
+      M.diagonal() += lambda * d_free;
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(M);
+      const Eigen::VectorXd delta_free = ldlt.solve(-g_free);
+      if (ldlt.info() != Eigen::Success || !delta_free.allFinite()) {
+        lambda *= nu;
+        nu *= 2.0;
+        if (lambda > 1e20) {
+          out.message = "linear solve failed";
+          done = true;
+          break;
+        }
+        continue;
+      }
+      u_new = u;
+      for (int a = 0; a < nf; ++a) {
+        const int i = free_set[a];
+        u_new[i] = std::clamp(u[i] + delta_free[a], 0.0, 1.0);
+      }
+      step = u_new - u;
+      const double step_norm = step.norm();
+      const bool small_step = step_norm <= s.xtol_rel * (u.norm() + s.xtol_rel);
+      if (step_norm == 0.0) {
+        out.converged = true;
+        out.message = "step vanished at the bounds";
+        done = true;
+        break;
+      }
+      const double predicted = -(g.dot(step) + 0.5 * step.dot(A * step));
+      const bool ok = runner.main().normalised(u_new, r_new);
+      const double cost_new = ok ? half_squared_norm(r_new) : kInf;
+      const double actual = cost - cost_new;
+      const double rho = (ok && predicted > 0.0) ? actual / predicted : -1.0;
+      if (ok && actual > 0.0 && rho > 1e-4) {
+        const bool small_f = actual <= s.ftol_rel * cost && predicted <= s.ftol_rel * cost;
+        u = u_new;
+        r = r_new;
+        cost = cost_new;
+        lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+        nu = 2.0;
+        if (s.on_accept) s.on_accept(cost);
+        if (small_step) {
+          out.converged = true;
+          out.message = "step below xtol_rel";
+          done = true;
+        } else if (small_f) {
+          out.converged = true;
+          out.message = "relative cost change below ftol_rel";
+          done = true;
+        }
+        break;
+      }
+      if (small_step) {
+        out.converged = true;
+        out.message = "no decrease within xtol_rel of the point";
+        done = true;
+        break;
+      }
+      lambda *= nu;
+      nu *= 2.0;
+      if (lambda > 1e20) {
+        out.message = "no decrease found (damping limit)";
+        done = true;
+        break;
+      }
+    }
+  }
+  out.u = u;
+  out.r = r;
+  out.cost = cost;
+  return out;
+}
+
+/// Radical inverse of `index` in `base` (van der Corput).
+inline double radical_inverse(std::uint64_t index, std::uint64_t base) {
+  double result = 0.0, f = 1.0 / static_cast<double>(base);
+  while (index > 0) {
+    result += f * static_cast<double>(index % base);
+    index /= base;
+    f /= static_cast<double>(base);
+  }
+  return result;
+}
+
+/// `count` points of a Halton sequence in [0,1]^p with a seeded
+/// Cranley-Patterson shift (the same on every platform: raw mt19937_64 bits).
+inline std::vector<Eigen::VectorXd> shifted_halton(int p, int count, unsigned seed) {
+  std::vector<std::uint64_t> primes;
+  for (std::uint64_t c = 2; static_cast<int>(primes.size()) < p; ++c) {
+    bool prime = true;
+    for (const std::uint64_t q : primes)
+      if (c % q == 0) {
+        prime = false;
+        break;
+      }
+    if (prime) primes.push_back(c);
+  }
+  std::mt19937_64 gen(seed);
+  Eigen::VectorXd shift(p);
+  for (int j = 0; j < p; ++j) shift[j] = static_cast<double>(gen() >> 11) * 0x1.0p-53;
+  std::vector<Eigen::VectorXd> points;
+  points.reserve(static_cast<std::size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    Eigen::VectorXd x(p);
+    for (int j = 0; j < p; ++j) {
+      const double v = radical_inverse(static_cast<std::uint64_t>(k) + 1, primes[j]) + shift[j];
+      x[j] = v - std::floor(v);
+    }
+    points.push_back(std::move(x));
+  }
+  return points;
+}
+
+/// Objective adaptor for NLopt's derivative-free algorithms (serial).
+struct NloptObjective {
+  Evaluator* evaluator = nullptr;
+  const std::function<void(double)>* report = nullptr;  // progress, main thread
+  double worst_valid = 0.0;
+  double best = kInf;
+  Eigen::VectorXd best_u;
+
+  static double call(unsigned n, const double* x, double* grad, void* data) {
+    auto* self = static_cast<NloptObjective*>(data);
+    if (grad)
+      for (unsigned i = 0; i < n; ++i) grad[i] = 0.0;
+    const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(x, n);
+    Eigen::VectorXd r;
+    double value;
+    if (self->evaluator->normalised(u, r)) {
+      value = half_squared_norm(r);
+      self->worst_valid = std::max(self->worst_valid, value);
+      if (value < self->best) {
+        self->best = value;
+        self->best_u = u;
+      }
+    } else {
+      // Large but finite, and scaled to the problem so model-based methods
+      // are not wrecked: worse than every valid point seen so far.
+      value = 10.0 * std::max(1.0, self->worst_valid);
+    }
+    if (self->report && self->evaluator->evaluations % 10 == 0) (*self->report)(self->best);
+    return value;
+  }
+};
+
+/// Runs one NLopt algorithm on the cost in [0,1]^p from `u0`; returns the
+/// best valid point it saw (or u0) and appends a summary to `msg`.
+inline Eigen::VectorXd run_nlopt(nlopt_algorithm algorithm, Runner& runner,
+                                 const Eigen::VectorXd& u0, int max_evals, double xtol_rel,
+                                 double ftol_rel, unsigned seed, const Deadline& deadline,
+                                 const std::function<void(double)>& report, double& best_cost,
+                                 std::ostringstream& msg) {
+  const unsigned p = static_cast<unsigned>(u0.size());
+  NloptObjective objective;
+  objective.evaluator = &runner.main();
+  objective.report = &report;
+  nlopt_opt opt = nlopt_create(algorithm, p);
+  if (!opt) throw std::runtime_error("softrne::fit: nlopt_create failed");
+  nlopt_set_lower_bounds1(opt, 0.0);
+  nlopt_set_upper_bounds1(opt, 1.0);
+  nlopt_set_min_objective(opt, &NloptObjective::call, &objective);
+  nlopt_set_maxeval(opt, std::max(1, max_evals));
+  if (xtol_rel > 0) nlopt_set_xtol_rel(opt, xtol_rel);
+  if (ftol_rel > 0) nlopt_set_ftol_rel(opt, ftol_rel);
+  if (deadline.active) nlopt_set_maxtime(opt, std::max(1e-3, deadline.remaining_seconds()));
+  nlopt_srand(seed);  // CRS2 and friends draw from NLopt's (thread-local) RNG
+  std::vector<double> x(u0.data(), u0.data() + u0.size());
+  double f = 0.0;
+  const nlopt_result status = nlopt_optimize(opt, x.data(), &f);
+  const int evals = nlopt_get_numevals(opt);
+  nlopt_destroy(opt);
+  msg << nlopt_algorithm_to_string(algorithm) << ": " << evals << " evaluations, "
+      << nlopt_result_to_string(status);
+  if (objective.best_u.size() == p) {
+    best_cost = objective.best;
+    msg << ", best cost " << objective.best;
+    return objective.best_u;
+  }
+  msg << ", no valid point";
+  return u0;
+}
+
+/// Seeded multistart: screen `global_evals/2` points (the initial guess and
+/// a shifted Halton set), then refine the best distinct ones with short LM
+/// runs in parallel; returns the best refined point.
+inline Eigen::VectorXd multistart(Runner& runner, const Eigen::VectorXd& u0, const FitOptions& opt,
+                                  double fd_step, const Deadline& deadline, double& best_cost,
+                                  std::ostringstream& msg) {
+  const int p = static_cast<int>(u0.size());
+  const int n_screen = std::max(1, opt.global_evals / 2);
+  std::vector<Eigen::VectorXd> points = shifted_halton(p, n_screen - 1, opt.seed);
+  points.insert(points.begin(), u0);
+  std::vector<double> costs(points.size(), kInf);
+  runner.run(static_cast<int>(points.size()), [&](int k, Evaluator& ev) {
+    if (deadline.passed()) return;  // unevaluated points keep an infinite cost
+    Eigen::VectorXd r;
+    if (ev.normalised(points[k], r)) costs[k] = half_squared_norm(r);
+  });
+  int n_valid = 0;
+  for (const double c : costs) n_valid += std::isfinite(c) ? 1 : 0;
+  msg << "multistart: screened " << points.size() << " points ("
+      << (static_cast<int>(points.size()) - n_valid) << " failed)";
+
+  // Order: the initial guess first (if valid), then by cost; stable in index.
+  std::vector<int> order;
+  for (int k = 1; k < static_cast<int>(points.size()); ++k)
+    if (std::isfinite(costs[k])) order.push_back(k);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return costs[a] < costs[b]; });
+  if (std::isfinite(costs[0])) order.insert(order.begin(), 0);
+  if (order.empty()) {
+    msg << ", no valid point";
+    return u0;
+  }
+  int best_screened = order.front();
+  for (const int k : order)
+    if (costs[k] < costs[best_screened]) best_screened = k;
+
+  const int per_iteration = (opt.central_differences ? 2 * p : p) + 1;
+  const int budget_left = opt.global_evals - static_cast<int>(points.size());
+  int n_starts = std::max(0, std::min(opt.multistart_starts, static_cast<int>(order.size())));
+  while (n_starts > 0 && budget_left / n_starts < 2 * per_iteration + 1) --n_starts;
+  std::vector<int> starts;
+  for (const int k : order) {
+    if (static_cast<int>(starts.size()) >= n_starts) break;
+    bool distinct = true;
+    for (const int s : starts)
+      if ((points[k] - points[s]).lpNorm<Eigen::Infinity>() < 0.05) distinct = false;
+    if (distinct) starts.push_back(k);
+  }
+  if (starts.empty()) {
+    best_cost = costs[best_screened];
+    msg << ", best cost " << best_cost << " (no budget to refine)";
+    return points[best_screened];
+  }
+
+  LmSettings settings;
+  settings.max_evals = budget_left / static_cast<int>(starts.size());
+  settings.xtol_rel = std::max(opt.xtol_rel, 1e-4);
+  settings.ftol_rel = std::max(opt.ftol_rel, 1e-6);
+  settings.central = opt.central_differences;
+  settings.fd_step = fd_step;
+  settings.deadline = &deadline;
+  std::vector<LmOutcome> refined(starts.size());
+  runner.run(static_cast<int>(starts.size()), [&](int k, Evaluator& ev) {
+    Runner serial({&ev});
+    refined[k] = levenberg_marquardt(serial, points[starts[k]], settings);
+  });
+  int best = -1;
+  for (int k = 0; k < static_cast<int>(refined.size()); ++k)
+    if (refined[k].valid && (best < 0 || refined[k].cost < refined[best].cost)) best = k;
+  msg << ", refined " << starts.size() << " starts";
+  if (best < 0 || refined[best].cost > costs[best_screened]) {
+    best_cost = costs[best_screened];
+    msg << ", best cost " << best_cost;
+    return points[best_screened];
+  }
+  best_cost = refined[best].cost;
+  msg << ", best cost " << best_cost;
+  return refined[best].u;
+}
+
+/// Fills the identifiability fields of `res` at `res.params` (r = residual there).
+inline void identifiability(const ParameterSet& ps, Runner& runner, const Eigen::VectorXd& r,
+                            const IdentifiabilityOptions& io, FitResult& res) {
+  const int p = ps.size();
+  const Eigen::Index m = r.size();
+  const Eigen::VectorXd x = res.params;
+  const Eigen::VectorXd lo = ps.lower(), hi = ps.upper();
+  const double h_rel =
+      io.fd_step > 0.0 ? io.fd_step : std::cbrt(std::numeric_limits<double>::epsilon());
+
+  // "Parameter magnitude": |x|, floored for values near zero.
+  Eigen::VectorXd magnitude(p);
+  for (int i = 0; i < p; ++i) magnitude[i] = std::max(std::abs(x[i]), 1e-3 * (hi[i] - lo[i]));
+
+  // Central differences w.r.t. physical parameters, one-sided at bounds/failures.
+  Eigen::MatrixXd J(m, p);
+  std::vector<char> column_ok(static_cast<std::size_t>(p), 0);
+  runner.run(p, [&](int k, Evaluator& ev) {
+    const double h = h_rel * magnitude[k];
+    Eigen::VectorXd v = x, r_plus, r_minus;
+    const double up = x[k] + h, down = x[k] - h;
+    bool a = false, b = false;
+    if (up <= hi[k]) {
+      v[k] = up;
+      a = ev.physical(v, r_plus);
+    }
+    if (down >= lo[k]) {
+      v[k] = down;
+      b = ev.physical(v, r_minus);
+    }
+    bool ok = true;
+    if (a && b)
+      J.col(k) = (r_plus - r_minus) / (up - down);
+    else if (a)
+      J.col(k) = (r_plus - r) / (up - x[k]);
+    else if (b)
+      J.col(k) = (r - r_minus) / (x[k] - down);
+    else
+      ok = false;
+    if (!ok) J.col(k).setZero();
+    column_ok[k] = ok ? 1 : 0;
+  });
+
+  // SVD of J scaled by parameter magnitude (derivatives w.r.t. relative changes).
+  const Eigen::MatrixXd J_scaled = J * magnitude.asDiagonal();
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J_scaled, Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  const Eigen::MatrixXd& V = svd.matrixV();
+  res.singular_values = sv;
+  const double s_max = sv.size() ? sv.maxCoeff() : 0.0;
+  const double s_min = sv.size() ? sv.minCoeff() : 0.0;
+  res.condition_number = s_min > 0.0 ? s_max / s_min : kInf;
+  int rank = 0;
+  for (Eigen::Index k = 0; k < sv.size(); ++k)
+    if (sv[k] > io.null_space_rtol * s_max && sv[k] > 0.0) ++rank;
+
+  // A parameter with more than 1% of its unit vector in the null space is
+  // undetermined: moving along the null direction leaves the residual unchanged.
+  constexpr double kNullComponent = 1e-2;
+  std::vector<bool> in_null(static_cast<std::size_t>(p), false);
+  for (int i = 0; i < p; ++i) {
+    double w2 = 0.0;
+    for (Eigen::Index k = rank; k < V.cols(); ++k) w2 += V(i, k) * V(i, k);
+    in_null[i] = std::sqrt(w2) > kNullComponent;
+  }
+
+  // Pseudo-inverse of the scaled Gauss-Newton Hessian, V_r S_r^{-2} V_r^T.
+  Eigen::MatrixXd H_scaled_pinv = Eigen::MatrixXd::Zero(p, p);
+  for (int k = 0; k < rank; ++k) H_scaled_pinv += V.col(k) * V.col(k).transpose() / (sv[k] * sv[k]);
+  const Eigen::MatrixXd unscaled_cov =
+      magnitude.asDiagonal() * H_scaled_pinv * magnitude.asDiagonal();
+
+  const int dof = static_cast<int>(m) - p;
+  const double s2 = dof > 0 ? 2.0 * res.cost / dof : kInf;
+  res.covariance.resize(p, p);
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j < p; ++j)
+      res.covariance(i, j) = std::isfinite(s2) ? s2 * unscaled_cov(i, j) : kInf;
+  res.correlation = Eigen::MatrixXd::Identity(p, p);
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j < p; ++j) {
+      const double d = unscaled_cov(i, i) * unscaled_cov(j, j);
+      if (i != j) res.correlation(i, j) = d > 0.0 ? unscaled_cov(i, j) / std::sqrt(d) : 0.0;
+    }
+  res.std_errors.resize(p);
+  res.relative_std_errors.resize(p);
+  res.identifiable.assign(static_cast<std::size_t>(p), false);
+  for (int i = 0; i < p; ++i) {
+    const bool undetermined = in_null[i] || !column_ok[i];
+    const double se = (undetermined || !std::isfinite(s2))
+                          ? kInf
+                          : std::sqrt(std::max(0.0, s2 * unscaled_cov(i, i)));
+    res.std_errors[i] = se;
+    res.relative_std_errors[i] = se / magnitude[i];
+    res.identifiable[i] = !undetermined && res.relative_std_errors[i] < io.max_relative_std_error;
+  }
+
+  // Report.
+  std::ostringstream rep;
+  rep << std::setprecision(4);
+  rep << "identifiability at the optimum: m = " << m << " residuals, p = " << p
+      << " parameters, rms residual = " << res.rms;
+  if (dof > 0) rep << ", noise estimate s = " << std::sqrt(s2);
+  rep << "\n";
+  rep << "condition number of J scaled by parameter magnitude: " << res.condition_number
+      << " (rank " << rank << " of " << p << ")\n";
+  if (dof <= 0) rep << "m <= p: the noise variance cannot be estimated; std errors are infinite\n";
+  std::size_t width = 4;
+  for (const Parameter& q : ps.parameters()) width = std::max(width, q.name.size());
+  for (int i = 0; i < p; ++i) {
+    const std::size_t ui = static_cast<std::size_t>(i);
+    rep << "  " << std::left << std::setw(static_cast<int>(width)) << ps[i].name << std::right
+        << " = " << std::setw(11) << x[i] << " +- " << std::setw(10) << res.std_errors[i] << " ("
+        << std::setw(9) << 100.0 * res.relative_std_errors[i] << " %)  ";
+    if (res.identifiable[ui])
+      rep << "identifiable";
+    else if (!column_ok[ui])
+      rep << "NOT IDENTIFIABLE: residual failed on both sides, no derivative";
+    else if (in_null[ui])
+      rep << "NOT IDENTIFIABLE: in the null space of J (see below)";
+    else
+      rep << "POORLY DETERMINED: relative std error above " << 100.0 * io.max_relative_std_error
+          << " %";
+    if (x[i] <= lo[i] || x[i] >= hi[i]) rep << " [at a bound: std error unreliable]";
+    rep << "\n";
+  }
+  for (Eigen::Index k = rank; k < V.cols(); ++k) {
+    rep << "null direction (singular value " << sv[k] << " of " << s_max
+        << "): the residual does not change along ";
+    bool first = true;
+    for (int i = 0; i < p; ++i) {
+      if (std::abs(V(i, k)) <= kNullComponent) continue;
+      rep << (first ? "" : " ") << (V(i, k) < 0 ? "- " : (first ? "" : "+ ")) << std::abs(V(i, k))
+          << " d" << ps[i].name << "/|" << ps[i].name << "|";
+      first = false;
+    }
+    rep << "\n";
+  }
+  for (int i = 0; i < p; ++i)
+    for (int j = i + 1; j < p; ++j)
+      if (std::abs(res.correlation(i, j)) > io.correlation_threshold)
+        rep << "correlated: " << ps[i].name << " and " << ps[j].name << " (corr = " << std::showpos
+            << res.correlation(i, j) << std::noshowpos << ")\n";
+  res.identifiability_report = rep.str();
+}
+
+inline FitResult fit_impl(const ParameterSet& ps, int m, std::vector<ResidualFn> functors,
+                          const FitOptions& opt, const std::string& note) {
+  const int p = ps.size();
+  if (p < 1) throw std::invalid_argument("softrne::fit::fit_least_squares: no parameters");
+  if (m < 1) throw std::invalid_argument("softrne::fit::fit_least_squares: residual_size < 1");
+  std::vector<Evaluator> evaluators;
+  evaluators.reserve(functors.size());
+  for (ResidualFn& f : functors) evaluators.emplace_back(ps, m, std::move(f));
+  std::vector<Evaluator*> pointers;
+  for (Evaluator& e : evaluators) pointers.push_back(&e);
+  Runner runner(pointers);
+
+  Deadline deadline;
+  if (opt.max_wall_seconds > 0.0) {
+    deadline.active = true;
+    deadline.end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>(opt.max_wall_seconds));
+  }
+  const double fd_step = opt.fd_step > 0.0 ? opt.fd_step : (opt.central_differences ? 1e-5 : 1e-6);
+  double best_cost = kInf;
+  const std::function<void(double)> report = [&](double c) {
+    best_cost = std::min(best_cost, c);
+    if (opt.progress) opt.progress(runner.evaluations(), best_cost);
+  };
+  std::ostringstream msg;
+  msg << std::setprecision(6);
+
+  // Global stage.
+  Eigen::VectorXd u = ps.to_normalised(ps.initial());
+  if (opt.global_evals > 0) {
+    double c = kInf;
+    switch (opt.global_method) {
+      case GlobalMethod::multistart:
+        u = multistart(runner, u, opt, fd_step, deadline, c, msg);
+        break;
+      case GlobalMethod::crs2_lm:
+        u = run_nlopt(NLOPT_GN_CRS2_LM, runner, u, opt.global_evals, 0.0, 0.0, opt.seed, deadline,
+                      report, c, msg);
+        break;
+      case GlobalMethod::direct_l:
+        u = run_nlopt(NLOPT_GN_DIRECT_L, runner, u, opt.global_evals, 0.0, 0.0, opt.seed, deadline,
+                      report, c, msg);
+        break;
+    }
+    report(c);
+    msg << "; ";
+  }
+
+  // Local stage.
+  int local_budget = opt.local_evals;
+  if (opt.local_method == LocalMethod::bobyqa_then_lm) {
+    const int start = runner.evaluations();
+    double c = kInf;
+    u = run_nlopt(NLOPT_LN_BOBYQA, runner, u, opt.local_evals / 2, opt.xtol_rel, opt.ftol_rel,
+                  opt.seed, deadline, report, c, msg);
+    report(c);
+    msg << "; ";
+    local_budget -= runner.evaluations() - start;
+  }
+  LmSettings settings;
+  settings.max_evals = std::max(1, local_budget);
+  settings.xtol_rel = opt.xtol_rel;
+  settings.ftol_rel = opt.ftol_rel;
+  settings.central = opt.central_differences;
+  settings.fd_step = fd_step;
+  settings.deadline = &deadline;
+  settings.on_accept = report;
+  const LmOutcome lm = levenberg_marquardt(runner, u, settings);
+  msg << "Levenberg-Marquardt: " << lm.iterations << " iterations, " << lm.message;
+
+  FitResult res;
+  res.converged = lm.valid && lm.converged;
+  if (lm.valid) {
+    res.params = ps.to_physical(lm.u);
+    res.residual = lm.r;
+    res.cost = lm.cost;
+    res.rms = std::sqrt(2.0 * lm.cost / m);
+    if (opt.compute_identifiability) identifiability(ps, runner, lm.r, opt.identifiability, res);
+  } else {
+    res.params = ps.initial();
+    msg << "; no point where the residual succeeds was found";
+  }
+  if (!res.identifiable.size()) {
+    res.covariance = Eigen::MatrixXd::Constant(p, p, kInf);
+    res.std_errors = Eigen::VectorXd::Constant(p, kInf);
+    res.relative_std_errors = Eigen::VectorXd::Constant(p, kInf);
+    res.correlation = Eigen::MatrixXd::Identity(p, p);
+    res.singular_values = Eigen::VectorXd::Zero(p);
+    res.identifiable.assign(static_cast<std::size_t>(p), false);
+    if (res.identifiability_report.empty())
+      res.identifiability_report = "identifiability not computed\n";
+  }
+  res.evaluations = runner.evaluations();
+  res.failed_evaluations = runner.failures();
+  for (const std::string& n : ps.notes()) msg << "; " << n;
+  if (!note.empty()) msg << "; " << note;
+  res.message = msg.str();
+  if (opt.progress && lm.valid) opt.progress(res.evaluations, res.cost);
+  return res;
+}
+
+}  // namespace detail
+
+/// \brief Fits `params` so that the residual is least-squares small.
+///
+/// Global stage (`opt.global_evals` evaluations, deterministic for a seed),
+/// then projected Levenberg-Marquardt (`opt.local_evals`), then the
+/// identifiability analysis at the optimum. `residual` is called from the
+/// calling thread only, so `opt.threads` is ignored here (see the
+/// ResidualFactory overload).
+/// \param residual_size the fixed length \f$m\f$ of the residual.
+inline FitResult fit_least_squares(const ParameterSet& params, int residual_size,
+                                   const ResidualFn& residual, const FitOptions& opt = {}) {
+  return detail::fit_impl(
+      params, residual_size, {residual}, opt,
+      opt.threads > 1 ? "threads > 1 ignored: pass a ResidualFactory to evaluate in parallel" : "");
+}
+
+/// \brief As above, evaluating independent candidates (multistart points and
+///        starts, Jacobian columns) on `opt.threads` threads, each with its
+///        own functor from `make_residual` (called `max(1, opt.threads)`
+///        times, on the calling thread). The result equals the serial one
+///        bit for bit when the functors are deterministic.
+inline FitResult fit_least_squares(const ParameterSet& params, int residual_size,
+                                   const ResidualFactory& make_residual,
+                                   const FitOptions& opt = {}) {
+  std::vector<ResidualFn> functors;
+  for (int w = 0; w < std::max(1, opt.threads); ++w) functors.push_back(make_residual());
+  return detail::fit_impl(params, residual_size, std::move(functors), opt, "");
+}
+
+/// \brief Identifiability analysis alone at `result.params` (e.g. at a
+///        hand-picked point): fills cost, rms and the identifiability fields.
+inline void analyse_identifiability(const ParameterSet& params, int residual_size,
+                                    const ResidualFn& residual, FitResult& result,
+                                    const IdentifiabilityOptions& io = {}) {
+  detail::Evaluator ev(params, residual_size, residual);
+  detail::Runner runner({&ev});
+  Eigen::VectorXd r;
+  if (!ev.physical(result.params, r))
+    throw std::invalid_argument(
+        "softrne::fit::analyse_identifiability: the residual fails at result.params");
+  result.cost = detail::half_squared_norm(r);
+  result.residual = r;
+  result.rms = std::sqrt(2.0 * result.cost / residual_size);
+  detail::identifiability(params, runner, r, io, result);
+}
+
+}  // namespace softrne::fit

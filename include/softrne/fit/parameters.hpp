@@ -1,0 +1,150 @@
+#pragma once
+/// \file
+/// \brief Named, bounded fit parameters and their map to the optimiser's
+///        normalised coordinates.
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace softrne::fit {
+
+/// \brief One scalar parameter of a fit, in physical units.
+///
+/// Invariants (checked by ParameterSet::add): `lower < upper`, both finite;
+/// `lower > 0` when `log_scale`; `initial` is clamped into `[lower, upper]`.
+struct Parameter {
+  std::string name;
+  double initial = 0.0;
+  double lower = 0.0;
+  double upper = 1.0;
+  /// Search in \f$\log x\f$ (for positive quantities spanning decades).
+  bool log_scale = false;
+};
+
+/// \brief An ordered set of parameters and the map between physical values
+///        \f$x\f$ and normalised coordinates \f$u \in [0,1]^p\f$.
+///
+/// \f$u_i = (x_i - l_i)/(h_i - l_i)\f$, or
+/// \f$u_i = (\log x_i - \log l_i)/(\log h_i - \log l_i)\f$ when log-scaled.
+/// The optimisers work in \f$u\f$, so every parameter has a unit box and
+/// finite-difference steps and tolerances mean the same for all of them.
+class ParameterSet {
+ public:
+  ParameterSet() = default;
+
+  /// \brief Validates and adds each parameter (see add()).
+  explicit ParameterSet(const std::vector<Parameter>& parameters) {
+    for (const Parameter& p : parameters) add(p);
+  }
+
+  /// \brief Validates and appends a parameter; returns its index.
+  /// \throws std::invalid_argument on an empty or duplicate name, non-finite
+  ///         values, `lower >= upper`, or `lower <= 0` with `log_scale`.
+  ///         An `initial` outside the bounds is clamped and a note recorded.
+  int add(Parameter p) {
+    if (p.name.empty()) throw std::invalid_argument("softrne::fit: parameter with an empty name");
+    if (index_of(p.name) >= 0)
+      throw std::invalid_argument("softrne::fit: duplicate parameter name '" + p.name + "'");
+    if (!std::isfinite(p.lower) || !std::isfinite(p.upper) || !std::isfinite(p.initial))
+      throw std::invalid_argument("softrne::fit: parameter '" + p.name +
+                                  "' has a non-finite value");
+    if (!(p.lower < p.upper))
+      throw std::invalid_argument("softrne::fit: parameter '" + p.name + "' needs lower < upper");
+    if (p.log_scale && !(p.lower > 0.0))
+      throw std::invalid_argument("softrne::fit: log-scaled parameter '" + p.name +
+                                  "' needs lower > 0");
+    if (p.initial < p.lower || p.initial > p.upper) {
+      const double clamped = std::clamp(p.initial, p.lower, p.upper);
+      std::ostringstream note;
+      note << "parameter '" << p.name << "': initial value " << p.initial << " outside [" << p.lower
+           << ", " << p.upper << "], clamped to " << clamped;
+      notes_.push_back(note.str());
+      p.initial = clamped;
+    }
+    parameters_.push_back(std::move(p));
+    return static_cast<int>(parameters_.size()) - 1;
+  }
+
+  /// \brief Number of parameters \f$p\f$.
+  int size() const { return static_cast<int>(parameters_.size()); }
+  const Parameter& operator[](int i) const { return parameters_.at(static_cast<std::size_t>(i)); }
+  const std::vector<Parameter>& parameters() const { return parameters_; }
+  /// \brief Notes written during validation (clamped initial values).
+  const std::vector<std::string>& notes() const { return notes_; }
+
+  /// \brief Index of the parameter called `name`, or -1.
+  int index_of(const std::string& name) const {
+    for (std::size_t i = 0; i < parameters_.size(); ++i)
+      if (parameters_[i].name == name) return static_cast<int>(i);
+    return -1;
+  }
+
+  Eigen::VectorXd initial() const { return collect(&Parameter::initial); }
+  Eigen::VectorXd lower() const { return collect(&Parameter::lower); }
+  Eigen::VectorXd upper() const { return collect(&Parameter::upper); }
+
+  /// \brief \f$u_i(x_i)\f$; values outside the bounds are clamped first.
+  double to_normalised(int i, double x) const {
+    const Parameter& p = (*this)[i];
+    x = std::clamp(x, p.lower, p.upper);
+    const double u =
+        p.log_scale ? (std::log(x) - std::log(p.lower)) / (std::log(p.upper) - std::log(p.lower))
+                    : (x - p.lower) / (p.upper - p.lower);
+    return std::clamp(u, 0.0, 1.0);
+  }
+
+  /// \brief \f$x_i(u_i)\f$; `u` is clamped into [0, 1] and the result into the bounds.
+  double to_physical(int i, double u) const {
+    const Parameter& p = (*this)[i];
+    u = std::clamp(u, 0.0, 1.0);
+    const double x = p.log_scale
+                         ? std::exp(std::log(p.lower) + u * (std::log(p.upper) - std::log(p.lower)))
+                         : p.lower + u * (p.upper - p.lower);
+    return std::clamp(x, p.lower, p.upper);
+  }
+
+  /// \brief Element-wise to_normalised().
+  Eigen::VectorXd to_normalised(const Eigen::VectorXd& x) const {
+    check_size(x);
+    Eigen::VectorXd u(size());
+    for (int i = 0; i < size(); ++i) u[i] = to_normalised(i, x[i]);
+    return u;
+  }
+
+  /// \brief Element-wise to_physical().
+  Eigen::VectorXd to_physical(const Eigen::VectorXd& u) const {
+    check_size(u);
+    Eigen::VectorXd x(size());
+    for (int i = 0; i < size(); ++i) x[i] = to_physical(i, u[i]);
+    return x;
+  }
+
+  /// \brief \f$dx_i/du_i\f$ at physical value `x` (chain rule for Jacobians).
+  double dphysical_dnormalised(int i, double x) const {
+    const Parameter& p = (*this)[i];
+    return p.log_scale ? x * (std::log(p.upper) - std::log(p.lower)) : (p.upper - p.lower);
+  }
+
+ private:
+  Eigen::VectorXd collect(double Parameter::*member) const {
+    Eigen::VectorXd v(size());
+    for (int i = 0; i < size(); ++i) v[i] = parameters_[static_cast<std::size_t>(i)].*member;
+    return v;
+  }
+  void check_size(const Eigen::VectorXd& v) const {
+    if (v.size() != size())
+      throw std::invalid_argument("softrne::fit: vector size does not match the parameter set");
+  }
+
+  std::vector<Parameter> parameters_;
+  std::vector<std::string> notes_;
+};
+
+}  // namespace softrne::fit
