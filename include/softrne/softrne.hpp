@@ -13,3 +13,4 @@
 #include "softrne/algorithms/rnea.hpp"
 #include "softrne/algorithms/bias.hpp"
 #include "softrne/algorithms/mass_matrix.hpp"
+#include "softrne/algorithms/forward_dynamics.hpp"

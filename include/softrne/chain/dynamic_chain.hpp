@@ -110,8 +110,9 @@ struct DynamicChainData {
   std::vector<FrameMotion<Scalar>> motion;
   std::vector<BodyLoad<Scalar>> loads;
   std::vector<Wrench<Scalar>> wrench;
-  VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit;
+  VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit, qddot;
   MatrixQ mass_matrix;
+  MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
 
   DynamicChainData() = default;
   explicit DynamicChainData(const DynamicChain<Scalar>& chain) {
@@ -132,7 +133,9 @@ struct DynamicChainData {
     bias_forces = VectorQ::Zero(nq);
     qdot_zero = VectorQ::Zero(nq);
     unit = VectorQ::Zero(nq);
+    qddot = VectorQ::Zero(nq);
     mass_matrix = MatrixQ::Zero(nq, nq);
+    mass_factor = MatrixQ::Zero(nq, nq);
   }
   int num_segments() const { return static_cast<int>(kinematics.size()); }
 };

@@ -108,8 +108,9 @@ struct ChainData<Chain<Segments...>> {
   std::array<FrameMotion<Scalar>, N + 1> motion;  ///< [0] base, [i+1] distal frame of segment i
   std::array<BodyLoad<Scalar>, N> loads;
   std::array<Wrench<Scalar>, N + 1> wrench;  ///< [i] at the base of segment i, [N] at the tip
-  typename ChainT::VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit;
+  typename ChainT::VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit, qddot;
   typename ChainT::MatrixQ mass_matrix;
+  typename ChainT::MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
 
   ChainData() = default;
   explicit ChainData(const ChainT&) {
@@ -118,6 +119,7 @@ struct ChainData<Chain<Segments...>> {
     bias_forces.setZero();
     qdot_zero.setZero();
     unit.setZero();
+    qddot.setZero();
     mass_matrix.setZero();
   }
   int num_segments() const { return N; }
