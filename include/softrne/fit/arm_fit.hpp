@@ -1,0 +1,233 @@
+#pragma once
+/// \file
+/// \brief System identification of an arm: stiffness, damping (and optionally pressure gains
+/// and effect parameters) fitted to measured angles by simulation error (paper section IV-B).
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "softrne/fit/least_squares.hpp"
+#include "softrne/fit/parameters.hpp"
+#include "softrne/io/csv.hpp"
+#include "softrne/model/arm_model.hpp"
+#include "softrne/model/error_stats.hpp"
+#include "softrne/sim/arm_simulation.hpp"
+
+namespace softrne::fit {
+
+/// \brief Bounds of an effect parameter (per effect type, never per data set).
+struct EffectBounds {
+  double lower, upper;
+  bool log_scale;
+};
+
+/// \brief Physically plausible ranges of each effect's parameter.
+inline EffectBounds effect_bounds(const AnyEffect& e, double total_mass) {
+  if (std::holds_alternative<Stiffening>(e)) return {-1.0, 20.0, false};            // 1/rad^2
+  if (std::holds_alternative<PressureStiffening>(e)) return {-5.0, 50.0, false};    // 1/MPa
+  if (std::holds_alternative<ActuatorLag>(e)) return {1e-3, 2.0, true};             // s
+  if (std::holds_alternative<CoulombFriction>(e)) return {0.0, 5.0, false};         // N m
+  if (std::holds_alternative<QuadraticDamping>(e)) return {0.0, 50.0, false};       // N m s^2
+  if (std::holds_alternative<ChamberMisalignment>(e)) return {-1.5, 1.5, false};    // rad
+  if (std::holds_alternative<Payload>(e)) return {0.0, 3.0 * total_mass, false};    // kg
+  return {-0.3, 0.3, false};                                                         // rad
+}
+
+/// \brief What to fit.
+struct ArmFitOptions {
+  bool stiffness = true;       ///< per-axis K_spring of every joint
+  bool damping = true;         ///< per-axis K_d of every joint
+  bool pressure_gain = false;  ///< one factor on K_prs per CC joint
+  bool effects = true;         ///< the parameters of the model's effects
+  /// Bounds of K and D: [x0 / range, x0 * range] around the starting guess (log scale).
+  double stiffness_range = 30.0;
+  /// Samples that enter the objective (weight 1) or not (0); empty = all. Used for
+  /// cross-validation: the simulation still runs through every sample.
+  std::vector<bool> sample_mask;
+  sim::ArmSimulationOptions simulation = default_simulation();
+  FitOptions optimiser = default_optimiser();
+
+  static sim::ArmSimulationOptions default_simulation() {
+    sim::ArmSimulationOptions s;
+    s.cvode.rtol = 1e-6;
+    s.cvode.atol = 1e-6;
+    s.cvode.max_wall_seconds = 60;
+    return s;
+  }
+  static FitOptions default_optimiser() {
+    FitOptions o;
+    o.global_evals = 12;
+    o.multistart_starts = 2;
+    o.local_evals = 300;
+    o.threads = 2;
+    o.xtol_rel = 1e-4;
+    o.ftol_rel = 1e-7;
+    o.fd_step = 1e-3;  // CVODE's tolerance is noise in finite differences
+    o.identifiability.fd_step = 1e-3;
+    return o;
+  }
+};
+
+/// \brief Outcome of fit_arm.
+struct ArmFitResult {
+  ArmDescription fitted;
+  FitResult fit;
+  ParameterSet parameters;
+  ErrorStats stats;  ///< on the fitting data (all samples)
+  int simulations = 0;
+  double wall_seconds = 0;
+};
+
+namespace detail {
+
+/// Which numbers of the description the parameter vector addresses.
+struct ParamSlot {
+  enum Kind { kStiffness, kDamping, kGain, kEffect } kind;
+  int joint;  // or effect index
+  int k;      // axis or effect parameter index
+};
+
+inline std::vector<ParamSlot> make_slots(const ArmDescription& d, const ArmFitOptions& o,
+                                         ParameterSet& ps) {
+  std::vector<ParamSlot> slots;
+  const double range = o.stiffness_range;
+  auto bounded = [&](double x0, double fallback) {
+    const double c = x0 > 0 ? x0 : fallback;
+    return std::pair<double, double>(c / range, c * range);
+  };
+  for (std::size_t j = 0; j < d.joints.size(); ++j) {
+    const ArmJoint& jt = d.joints[j];
+    for (int k = 0; k < jt.nq; ++k) {
+      const std::string axis = d.coordinate_names[static_cast<std::size_t>(jt.q_offset + k)];
+      if (o.stiffness) {
+        auto [lo, hi] = bounded(jt.stiffness(k), 1.0);
+        ps.add({"stiffness." + axis, std::max(jt.stiffness(k), lo), lo, hi, true});
+        slots.push_back({ParamSlot::kStiffness, static_cast<int>(j), k});
+      }
+      if (o.damping) {
+        auto [lo, hi] = bounded(jt.damping(k), 0.1);
+        ps.add({"damping." + axis, std::max(jt.damping(k), lo), lo, hi, true});
+        slots.push_back({ParamSlot::kDamping, static_cast<int>(j), k});
+      }
+    }
+    if (o.pressure_gain && jt.is_cc()) {
+      ps.add({"pressure_gain." + jt.name, 1.0, 0.3, 3.0, true});
+      slots.push_back({ParamSlot::kGain, static_cast<int>(j), 0});
+    }
+  }
+  if (o.effects) {
+    double total_mass = 0;
+    for (const auto& s : d.spec.segments)
+      std::visit([&](const auto& x) {
+        if constexpr (!std::is_same_v<std::decay_t<decltype(x)>, io::RevoluteJointSpec>) total_mass += x.mass;
+      }, s);
+    for (std::size_t e = 0; e < d.effects.size(); ++e) {
+      const auto names = effect_param_names(d.effects[e], d.joints, d.coordinate_names);
+      const EffectBounds b = effect_bounds(d.effects[e], total_mass);
+      const auto& params = effect_base(d.effects[e]).params;
+      for (std::size_t k = 0; k < names.size(); ++k) {
+        ps.add({effect_name(d.effects[e]) + "." + names[k], params(static_cast<Eigen::Index>(k)),
+                b.lower, b.upper, b.log_scale});
+        slots.push_back({ParamSlot::kEffect, static_cast<int>(e), static_cast<int>(k)});
+      }
+    }
+  }
+  return slots;
+}
+
+inline void apply(const std::vector<ParamSlot>& slots, const Eigen::VectorXd& x,
+                  const ArmDescription& start, ArmDescription& d) {
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    const ParamSlot& s = slots[i];
+    const double v = x(static_cast<Eigen::Index>(i));
+    auto& jt = d.joints[static_cast<std::size_t>(s.joint)];
+    switch (s.kind) {
+      case ParamSlot::kStiffness: jt.stiffness(s.k) = v; break;
+      case ParamSlot::kDamping: jt.damping(s.k) = v; break;
+      case ParamSlot::kGain:
+        jt.pressure_to_torque = start.joints[static_cast<std::size_t>(s.joint)].pressure_to_torque * v;
+        break;
+      case ParamSlot::kEffect: effect_base(d.effects[static_cast<std::size_t>(s.joint)]).params(s.k) = v; break;
+    }
+  }
+}
+
+}  // namespace detail
+
+/// \brief Simulates the arm on a data set (from rest at the first measured row).
+inline sim::ArmSimulation simulate_dataset(const ArmDescription& d, const io::Dataset& data,
+                                           const sim::ArmSimulationOptions& opt) {
+  const Eigen::VectorXd q0 =
+      data.has_angles ? Eigen::VectorXd(data.angles.row(0).transpose()) : Eigen::VectorXd::Zero(d.nq);
+  return sim::simulate_arm(d, data.t, data.pressures, q0, opt);
+}
+
+/// \brief Checks that a data set can support a fit; throws std::invalid_argument naming the
+/// data set and what is missing.
+inline void check_fit_data(const ArmDescription& d, const io::Dataset& data) {
+  if (!data.has_angles || data.angles.cols() != d.nq)
+    throw std::invalid_argument(data.source + ": the data set has no measured angles for every coordinate");
+  if (data.t.size() < 20)
+    throw std::invalid_argument(data.source + ": too short to fit (" + std::to_string(data.t.size()) +
+                                " samples; at least 20 are needed)");
+  const Eigen::VectorXd prange = data.pressures.colwise().maxCoeff() - data.pressures.colwise().minCoeff();
+  const Eigen::VectorXd qrange = data.angles.colwise().maxCoeff() - data.angles.colwise().minCoeff();
+  if (data.pressures.cols() > 0 && prange.maxCoeff() <= 0 && qrange.maxCoeff() < 1e-3)
+    throw std::invalid_argument(data.source +
+                                ": the pressures are constant and the arm does not move: stiffness and "
+                                "damping are not identifiable from it");
+}
+
+/// \brief Fits the free parameters of `start` to the measured angles of `data`, minimising the
+/// simulation error (the model is simulated from the first sample with the recorded pressures,
+/// not one step ahead). Deterministic for a given optimiser seed.
+inline ArmFitResult fit_arm(const ArmDescription& start, const io::Dataset& data,
+                            const ArmFitOptions& opt = {}) {
+  check_fit_data(start, data);
+  const auto t0 = std::chrono::steady_clock::now();
+  ArmFitResult out;
+  const std::vector<detail::ParamSlot> slots = detail::make_slots(start, opt, out.parameters);
+  const int nq = start.nq;
+  const Eigen::Index N = data.t.size();
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index i = 0; i < N; ++i)
+    if (opt.sample_mask.empty() || opt.sample_mask[static_cast<std::size_t>(i)]) rows.push_back(i);
+  const int m = static_cast<int>(rows.size()) * nq;
+  const double scale = 1.0 / std::sqrt(static_cast<double>(rows.size()));  // r^2 sums to MSE
+  std::atomic<int> sims{0};
+  auto make_residual = [&]() -> ResidualFn {
+    return [&, d = start](const Eigen::VectorXd& x, Eigen::VectorXd& r) mutable {
+      detail::apply(slots, x, start, d);
+      // Payload mass changes the chain; everything else is read at evaluation time.
+      const sim::ArmSimulation s = simulate_dataset(d, data, opt.simulation);
+      ++sims;
+      if (!s.ok() || s.angles.rows() != N) return false;
+      r.resize(m);
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        r.segment(static_cast<Eigen::Index>(i) * nq, nq) =
+            scale * (s.angles.row(rows[i]) - data.angles.row(rows[i])).transpose();
+      return true;
+    };
+  };
+  if (out.parameters.size() == 0) {
+    out.fitted = start;
+  } else {
+    out.fit = fit_least_squares(out.parameters, m, ResidualFactory(make_residual), opt.optimiser);
+    out.fitted = start;
+    if (out.fit.params.size() == out.parameters.size()) detail::apply(slots, out.fit.params, start, out.fitted);
+  }
+  const sim::ArmSimulation s = simulate_dataset(out.fitted, data, opt.simulation);
+  ++sims;
+  if (s.ok()) out.stats = error_stats(s.angles, data.angles, out.fitted.coordinate_names);
+  out.simulations = sims;
+  out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace softrne::fit
