@@ -1,0 +1,112 @@
+// softrne-loop: the closed loop (formats.md section 6): baseline fit, residual, effect
+// discovery, refit, report.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+
+#include "common/cli.hpp"
+#include "common/report.hpp"
+#include "softrne/fit/loop.hpp"
+#include "softrne/io/csv.hpp"
+#include "softrne/io/robot_json.hpp"
+
+namespace {
+
+// Writes what tools/plot_loop.py draws: simulated angles before and after on both data sets,
+// and the baseline residual against the first added effect's regressor; then runs the script.
+void write_plot_data(const std::string& dir, const softrne::fit::LoopResult& r, const softrne::io::Dataset& train,
+                     const softrne::io::Dataset& test, const softrne::fit::LoopOptions& opt) {
+  using namespace softrne;
+  if (std::system(("mkdir -p '" + dir + "'").c_str()) != 0)
+    throw io::InputError(io::Category::WriteFailed, dir, "", "cannot create the plot folder");
+  auto sim = [&](const ArmDescription& d, const io::Dataset& data, const std::string& name) {
+    const auto s = fit::simulate_dataset(d, data, opt.fit.simulation);
+    if (s.ok()) io::write_trajectory_csv(dir + "/" + name, data.t, s.angles, d.coordinate_names);
+  };
+  sim(r.baseline.fitted, train, "train_baseline.csv");
+  sim(r.final_fit.fitted, train, "train_final.csv");
+  sim(r.baseline.fitted, test, "test_baseline.csv");
+  sim(r.final_fit.fitted, test, "test_final.csv");
+  const auto& names = r.baseline.fitted.coordinate_names;
+  io::write_trajectory_csv(dir + "/residual_baseline.csv", train.t, r.residual, names);
+  io::write_trajectory_csv(dir + "/residual_final.csv", train.t, r.final_residual, names);
+  if (!r.added.empty()) {
+    const auto tr = fit::detail::differentiate(train, opt.smoothing);
+    const AnyEffect cand = fit::detail::make_candidate(effect_name(r.added[0].effect), r.baseline.fitted);
+    const Eigen::MatrixXd Phi = fit::detail::candidate_regressors(r.baseline.fitted, cand, tr);
+    Eigen::MatrixXd reg(train.t.size(), r.baseline.fitted.nq);
+    for (Eigen::Index i = 0; i < reg.rows(); ++i) reg.row(i) = Phi.block(i * reg.cols(), 0, reg.cols(), 1).transpose();
+    io::write_trajectory_csv(dir + "/regressor_" + effect_name(r.added[0].effect) + ".csv", train.t, reg, names);
+  }
+  const std::string script = std::string(SOFTRNE_SOURCE_DIR) + "/tools/plot_loop.py";
+  const std::string cmd = "python3 '" + script + "' --dir '" + dir + "' --train '" + train.source + "' --test '" +
+                          test.source + "' > /dev/null 2>&1";
+  if (std::system(cmd.c_str()) != 0)
+    std::fprintf(stderr, "softrne-loop: %s: plot data written; PNGs need python3 with numpy and matplotlib (%s)\n",
+                 dir.c_str(), script.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace softrne;
+  return cli::run("softrne-loop", [&] {
+    cli::ArgParser args("softrne-loop", "--robot R.json --train train.csv --test test.csv --out report.json [--plots DIR]",
+                        "Fits the declared model, ranks the candidate effects by how much of the equation-error "
+                        "residual each explains, confirms the best by cross-validation on the training data, "
+                        "adds the ones that earn their place, refits, and reports the error before and after "
+                        "(docs/closing-the-loop.md). The test data only measures.");
+    args.option("robot", "R.json", "robot description (softrne-robot/1)").required();
+    args.option("train", "train.csv", "training data (pressures and measured angles)").required();
+    args.option("test", "test.csv", "test data: measured only, never used to select").required();
+    args.option("out", "report.json", "the report (softrne-loop-report/1)").required();
+    args.option("plots", "DIR", "also write the data for plots and call tools/plot_loop.py if python3 is there");
+    args.option("threads", "N", "parallel simulations (default 2)");
+    args.flag("quiet", "no progress lines");
+    if (!args.parse(argc, argv)) return cli::kExitOk;
+    const io::RobotSpec spec = io::read_robot_json(args.value("robot"));
+    const io::Dataset train = io::read_dataset(args.value("train"), spec, true);
+    const io::Dataset test = io::read_dataset(args.value("test"), spec, true);
+    ArmDescription desc;
+    try {
+      desc = build_arm(spec);
+    } catch (const std::invalid_argument& e) {
+      throw cli::Failure(args.value("robot") + ": " + e.what());
+    }
+    fit::LoopOptions opt;
+    opt.fit.optimiser.threads = static_cast<int>(args.number("threads", 2, 1, 64));
+    if (!args.has("quiet")) opt.log = [](const std::string& s) { std::fprintf(stderr, "softrne-loop: %s\n", s.c_str()); };
+    fit::LoopResult r;
+    try {
+      r = fit::run_loop(desc, train, &test, opt);
+    } catch (const std::invalid_argument& e) {
+      throw cli::Failure(e.what());
+    }
+    if (args.has("plots")) write_plot_data(args.value("plots"), r, train, test, opt);
+    {
+      std::ofstream f(args.value("out"));
+      if (!f) throw io::InputError(io::Category::WriteFailed, args.value("out"), "", "cannot write the report");
+      f << cli::loop_report_json(r, true).dump(2) << "\n";
+    }
+    std::printf("closed loop in %.1f s\n", r.wall_seconds);
+    for (std::size_t k = 0; k < r.rounds.size(); ++k) {
+      std::printf("round %zu: candidates ranked by the share of the residual they explain\n", k + 1);
+      for (const auto& c : r.rounds[k]) {
+        std::printf("  %-22s %6.1f %%", c.name.c_str(), 100 * c.residual_explained);
+        if (c.confirmed)
+          std::printf("   held-out error %+6.1f %% / %+6.1f %%", -100 * c.fold_gains[0], -100 * c.fold_gains[1]);
+        std::printf("\n");
+      }
+    }
+    if (r.added.empty()) std::printf("no effect earned its place: the declared model stands\n");
+    for (const auto& a : r.added) std::printf("added %s: %s\n", effect_name(a.effect).c_str(), a.evidence.c_str());
+    std::printf("%s", cli::parameter_table(r.final_fit).c_str());
+    std::printf("%s", format_error_table(r.baseline.stats, "train, baseline").c_str());
+    std::printf("%s", format_error_table(r.final_train, "train, final").c_str());
+    std::printf("%s", format_error_table(r.baseline_test, "test, baseline").c_str());
+    std::printf("%s", format_error_table(r.final_test, "test, final").c_str());
+    std::printf("test median error: %.4f -> %.4f rad\nwrote %s\n", r.baseline_test.total.median, r.final_test.total.median,
+                args.value("out").c_str());
+    return cli::kExitOk;
+  });
+}
