@@ -30,6 +30,8 @@ struct ArmDescription {
   int num_inputs = 0;
   int num_effect_states = 0;
   std::vector<int> effect_state_offsets;
+  /// Consistent (Euler-Lagrange of the lumped energy) or the paper's frozen-inertia eq. 18.
+  InertiaRate inertia_rate = InertiaRate::Consistent;
 
   /// State x = [q, qdot, effect states].
   int num_states() const { return 2 * nq + num_effect_states; }
@@ -93,6 +95,7 @@ struct ArmDescription {
       c.add(p, "payload");
     }
     c.gravity = spec.gravity.cast<S>();
+    c.inertia_rate = inertia_rate;
     return c;
   }
 };
