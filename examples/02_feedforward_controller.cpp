@@ -64,8 +64,10 @@ int main() {
     p_max = std::max(p_max, p.maxCoeff());
     if (k % 50 == 0) {
       Eigen::internal::set_is_malloc_allowed(true);  // printing is outside the control law
-      std::printf("t = %.2f s  tau = [% .3f % .3f % .3f % .3f % .3f % .3f] N m  p1 = [%.0f %.0f %.0f %.0f] Pa\n", t,
-                  tau(0), tau(1), tau(2), tau(3), tau(4), tau(5), p(0), p(1), p(2), p(3));
+      std::printf(
+          "t = %.2f s  tau = [% .3f % .3f % .3f % .3f % .3f % .3f] N m  p1 = [%.0f %.0f %.0f %.0f] "
+          "Pa\n",
+          t, tau(0), tau(1), tau(2), tau(3), tau(4), tau(5), p(0), p(1), p(2), p(3));
       Eigen::internal::set_is_malloc_allowed(false);
     }
   }
