@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "softrne/fit/loop.hpp"
-#include "synthetic_arm.hpp"
+#include "../fit/synthetic_arm.hpp"
 
 namespace {
 
