@@ -7,8 +7,8 @@
 #   build/bin/softrne-loop --robot examples/data/arm-a-1/robot.json \
 #     --train examples/data/arm-a-1/train.csv --test examples/data/arm-a-1/test.csv \
 #     --out build/loop-report.json
-# Until softrne-loop exists it falls back to softrne-sim on the test set, then to the
-# examples in build/bin.
+# It first runs the example simulation (softrne-sim on the test set, error table), then the
+# closed loop with plots when numpy and matplotlib are present (install-deps.sh --python).
 # Environment: BUILD_DIR (default build), JOBS (default nproc), SOFTRNE_SKIP_DEPS=1.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -33,21 +33,28 @@ cmake --build "$build_dir" -j "$jobs"
 
 bin="$build_dir/bin"
 run() { echo "[run-main] \$ $*"; "$@"; }
-if [[ -x "$bin/softrne-loop" ]]; then
-  run "$bin/softrne-loop" --robot "$data/robot.json" --train "$data/train.csv" \
-    --test "$data/test.csv" --out "$build_dir/loop-report.json"
-  echo "[run-main] report: $build_dir/loop-report.json"
-elif [[ -x "$bin/softrne-sim" ]]; then
+# 1. The example simulation: the nominal robot on the test pressures, error table vs measured.
+if [[ -x "$bin/softrne-sim" ]]; then
   run "$bin/softrne-sim" --robot "$data/robot.json" --pressures "$data/test.csv" \
     --out "$build_dir/sim-test.csv"
   echo "[run-main] simulation: $build_dir/sim-test.csv"
-else
-  # Examples: executables in bin/ named example*, softrne-example* or NN_* / NN-*.
-  mapfile -t examples < <(find "$bin" -maxdepth 1 -type f -perm -u+x \
-    \( -name 'example*' -o -name 'softrne-example*' -o -name '[0-9][0-9][_-]*' \) 2>/dev/null | sort)
-  if [[ ${#examples[@]} -eq 0 ]]; then
-    echo "[run-main] nothing to run yet: no softrne-loop, softrne-sim or examples in $bin"
-    exit 0
-  fi
-  for ex in "${examples[@]}"; do run "$ex"; done
+fi
+# 2. The closed loop: baseline fit, residual, effect discovery, refit, report (+ plots).
+if [[ -x "$bin/softrne-loop" ]]; then
+  plots=()
+  for py in python3 /usr/bin/python3; do  # the first interpreter with numpy and matplotlib
+    if "$py" -c 'import numpy, matplotlib' 2>/dev/null; then
+      export SOFTRNE_PYTHON=$py
+      plots=(--plots "$build_dir/loop-plots")
+      break
+    fi
+  done
+  run "$bin/softrne-loop" --robot "$data/robot.json" --train "$data/train.csv" \
+    --test "$data/test.csv" --out "$build_dir/loop-report.json" "${plots[@]}"
+  echo "[run-main] report: $build_dir/loop-report.json"
+  if [[ ${#plots[@]} -gt 0 ]]; then echo "[run-main] plots: $build_dir/loop-plots/*.png"; fi
+fi
+if [[ ! -x "$bin/softrne-sim" && ! -x "$bin/softrne-loop" ]]; then
+  echo "[run-main] no tools were built in $bin" >&2
+  exit 1
 fi

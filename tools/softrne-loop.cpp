@@ -1,6 +1,7 @@
 // softrne-loop: the closed loop (formats.md section 6): baseline fit, residual, effect
 // discovery, refit, report.
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 
@@ -39,7 +40,8 @@ void write_plot_data(const std::string& dir, const softrne::fit::LoopResult& r, 
     io::write_trajectory_csv(dir + "/regressor_" + effect_name(r.added[0].effect) + ".csv", train.t, reg, names);
   }
   const std::string script = std::string(SOFTRNE_SOURCE_DIR) + "/tools/plot_loop.py";
-  const std::string cmd = "python3 '" + script + "' --dir '" + dir + "' --train '" + train.source + "' --test '" +
+  const char* py = std::getenv("SOFTRNE_PYTHON");
+  const std::string cmd = std::string(py && *py ? py : "python3") + " '" + script + "' --dir '" + dir + "' --train '" + train.source + "' --test '" +
                           test.source + "' > /dev/null 2>&1";
   if (std::system(cmd.c_str()) != 0)
     std::fprintf(stderr, "softrne-loop: %s: plot data written; PNGs need python3 with numpy and matplotlib (%s)\n",
@@ -60,7 +62,9 @@ int main(int argc, char** argv) {
     args.option("train", "train.csv", "training data (pressures and measured angles)").required();
     args.option("test", "test.csv", "test data: measured only, never used to select").required();
     args.option("out", "report.json", "the report (softrne-loop-report/1)").required();
-    args.option("plots", "DIR", "also write the data for plots and call tools/plot_loop.py if python3 is there");
+    args.option("plots", "DIR",
+                "also write the data for plots and draw them with tools/plot_loop.py (python3 with numpy and "
+                "matplotlib; another interpreter via the environment variable SOFTRNE_PYTHON)");
     args.option("threads", "N", "parallel simulations (default 2)");
     args.flag("quiet", "no progress lines");
     if (!args.parse(argc, argv)) return cli::kExitOk;
