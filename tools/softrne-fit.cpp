@@ -42,8 +42,10 @@ int main(int argc, char** argv) {
     opt.optimiser.threads = static_cast<int>(args.number("threads", 2, 1, 64));
     const bool quiet = args.has("quiet");
     if (!quiet)
-      opt.optimiser.progress = [](int evals, double cost) {
-        std::fprintf(stderr, "\rsoftrne-fit: %d simulations, best rms error %.5f rad   ", evals, std::sqrt(2 * cost));
+      opt.optimiser.progress = [nq = desc.nq](int evals, double cost) {
+        // The residual is scaled so that 2 cost = nq * (mean squared angle error).
+        std::fprintf(stderr, "\rsoftrne-fit: %d simulations, best rms error %.5f rad   ", evals,
+                     std::sqrt(2 * cost / nq));
       };
     auto before = [&](const io::Dataset& d) {
       const auto s = fit::simulate_dataset(desc, d, opt.simulation);

@@ -1,5 +1,6 @@
 // softrne-loop: the closed loop (formats.md section 6): baseline fit, residual, effect
 // discovery, refit, report.
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -97,8 +98,10 @@ int main(int argc, char** argv) {
       std::printf("round %zu: candidates ranked by the share of the residual they explain\n", k + 1);
       for (const auto& c : r.rounds[k]) {
         std::printf("  %-22s %6.1f %%", c.name.c_str(), 100 * c.residual_explained);
-        if (c.confirmed)
+        if (c.confirmed && std::isfinite(c.fold_gains[0]) && std::isfinite(c.fold_gains[1]))
           std::printf("   held-out error %+6.1f %% / %+6.1f %%", -100 * c.fold_gains[0], -100 * c.fold_gains[1]);
+        else if (c.confirmed)
+          std::printf("   refit failed to simulate in a fold: rejected");
         std::printf("\n");
       }
     }

@@ -36,7 +36,7 @@ inline EffectBounds effect_bounds(const AnyEffect& e, double total_mass) {
   if (std::holds_alternative<QuadraticDamping>(e)) return {0.0, 50.0, false};       // N m s^2
   if (std::holds_alternative<ChamberMisalignment>(e)) return {-1.5, 1.5, false};    // rad
   if (std::holds_alternative<Payload>(e)) return {0.0, 3.0 * total_mass, false};    // kg
-  return {-0.3, 0.3, false};                                                         // rad
+  return {-0.6, 0.6, false};                                                         // rad
 }
 
 /// \brief What to fit.

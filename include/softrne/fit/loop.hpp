@@ -345,8 +345,12 @@ inline LoopResult run_loop(const ArmDescription& declared, const io::Dataset& tr
       s.confirmed = true;
       s.fold_gains = {(base_cv[0] - cv[0]) / base_cv[0], (base_cv[1] - cv[1]) / base_cv[1]};
       s.cv_gain = ((base_cv[0] + base_cv[1]) - (cv[0] + cv[1])) / (base_cv[0] + base_cv[1]);
-      log("  " + s.name + ": explains " + std::to_string(100 * s.residual_explained) + " % of the residual, held-out error " +
-          std::to_string(100 * s.fold_gains[0]) + " % / " + std::to_string(100 * s.fold_gains[1]) + " % lower");
+      if (std::isfinite(s.cv_gain))
+        log("  " + s.name + ": explains " + std::to_string(100 * s.residual_explained) + " % of the residual, held-out error " +
+            std::to_string(100 * s.fold_gains[0]) + " % / " + std::to_string(100 * s.fold_gains[1]) + " % lower");
+      else
+        log("  " + s.name + ": explains " + std::to_string(100 * s.residual_explained) +
+            " % of the residual; its refit failed to simulate in a fold: rejected");
       const bool significant = s.fold_gains[0] >= opt.min_gain && s.fold_gains[1] >= opt.min_gain;
       if (significant && s.cv_gain > best_gain) {
         best = c;
