@@ -3,13 +3,30 @@
 /// \brief The two step bodies of the recursive Newton-Euler algorithm, written once for every
 /// segment type and both kinds of chain.
 
+#include <type_traits>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include "softrne/chain/motion.hpp"
+#include "softrne/segments/revolute_joint.hpp"
+#include "softrne/segments/rigid_link.hpp"
 
 namespace softrne {
 namespace detail {
+
+/// Segments whose distal frame is never rotated relative to their base (R_base_distal is the
+/// identity by construction): the passes skip multiplying by it (bit-identical results).
+template <class Segment>
+struct has_identity_rotation : std::false_type {};
+template <class Scalar>
+struct has_identity_rotation<RigidLink<Scalar>> : std::true_type {};
+/// Segments whose distal origin is their base origin (r_base_distal = 0 by construction, so
+/// the linear rows of J_distal and of Jdot_qdot_distal are zero too).
+template <class Segment>
+struct has_zero_translation : std::false_type {};
+template <class Scalar>
+struct has_zero_translation<RevoluteJoint<Scalar>> : std::true_type {};
 
 /// \brief Forward step (paper eqs. 11-15) across one segment: from the motion of its base
 /// frame to that of its distal frame, and the d'Alembert load of its own body.
@@ -31,10 +48,14 @@ void forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
   // Relative twist and its rate, in the base frame (eq. 7).
   Vector3 v_rel = Vector3::Zero(), w_rel = Vector3::Zero();
   Vector3 a_rel = Vector3::Zero(), dw_rel = Vector3::Zero();
+  constexpr bool turns = !has_identity_rotation<Segment>::value;
+  constexpr bool shifts = !has_zero_translation<Segment>::value;  // else J_v = 0 too
   if constexpr (nq > 0) {
-    v_rel = kin.J_distal.template topRows<3>() * qdot;
+    if constexpr (shifts) {
+      v_rel = kin.J_distal.template topRows<3>() * qdot;
+      a_rel = kin.J_distal.template topRows<3>() * qddot;
+    }
     w_rel = kin.J_distal.template bottomRows<3>() * qdot;
-    a_rel = kin.J_distal.template topRows<3>() * qddot;
     dw_rel = kin.J_distal.template bottomRows<3>() * qddot;
     if (velocity_terms) {
       a_rel += kin.Jdot_qdot_distal.template head<3>();
@@ -46,11 +67,24 @@ void forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
   const Vector3 omega = w + w_rel;                     // eq. 11
   const Vector3 alpha = dw + dw_rel + w.cross(w_rel);  // eq. 12
   // Eq. 15: acceleration of the distal origin (velocity of a point in a rotating frame).
-  Vector3 acc_e = base.acc + dw.cross(r_e) + a_rel;
-  if (velocity_terms) acc_e += w.cross(w.cross(r_e)) + Scalar(2) * w.cross(v_rel);
-  distal.omega.noalias() = R.transpose() * omega;
-  distal.alpha.noalias() = R.transpose() * alpha;
-  distal.acc.noalias() = R.transpose() * acc_e;
+  Vector3 acc_e = base.acc;
+  if constexpr (shifts) acc_e += dw.cross(r_e);
+  acc_e += a_rel;
+  if (velocity_terms) {
+    if constexpr (shifts && nq > 0)
+      acc_e += w.cross(w.cross(r_e)) + Scalar(2) * w.cross(v_rel);
+    else if constexpr (shifts)
+      acc_e += w.cross(w.cross(r_e));
+  }
+  if constexpr (turns) {
+    distal.omega.noalias() = R.transpose() * omega;
+    distal.alpha.noalias() = R.transpose() * alpha;
+    distal.acc.noalias() = R.transpose() * acc_e;
+  } else {
+    distal.omega = omega;
+    distal.alpha = alpha;
+    distal.acc = acc_e;
+  }
 
   if constexpr (Segment::has_body) {
     const Vector3& r_c = kin.r_base_com;
@@ -72,7 +106,10 @@ void forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
         if (inertia_rate == InertiaRate::Consistent) torque += kin.inertia_rate * distal.omega;
       }
     }
-    load.torque.noalias() = R * torque;
+    if constexpr (turns)
+      load.torque.noalias() = R * torque;
+    else
+      load.torque = torque;
     load.omega_distal = velocity_terms ? distal.omega : Vector3::Zero();
   }
 }
@@ -95,26 +132,34 @@ void backward_step(const Segment&, const typename Segment::Kinematics& kin,
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   constexpr int nq = Segment::nq;
   const auto& R = kin.R_base_distal;
-  const Vector3 F = R * distal.force;
-  const Vector3 N = R * distal.torque;
+  constexpr bool turns = !has_identity_rotation<Segment>::value;
+  const Vector3 F = turns ? Vector3(R * distal.force) : distal.force;
+  const Vector3 N = turns ? Vector3(R * distal.torque) : distal.torque;
   if constexpr (nq > 0) {
     auto& tau = const_cast<Eigen::MatrixBase<Tau>&>(tau_out);
-    tau.noalias() = kin.J_distal.template topRows<3>().transpose() * F;
-    tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * N;
+    if constexpr (has_zero_translation<Segment>::value) {  // J_v = 0
+      tau.noalias() = kin.J_distal.template bottomRows<3>().transpose() * N;
+    } else {
+      tau.noalias() = kin.J_distal.template topRows<3>().transpose() * F;
+      tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * N;
+    }
     if constexpr (Segment::has_body) {
       tau.noalias() += kin.J_com.transpose() * load.force;
       tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * load.torque;
       if (inertia_rate == InertiaRate::Consistent) {
         // -dT/dq_k of the rotational energy 1/2 w^T I(q) w.
         for (int k = 0; k < nq; ++k)
-          tau(k) -= Scalar(0.5) * load.omega_distal.dot(
-                                      kin.dinertia_dq[static_cast<std::size_t>(k)] *
-                                      load.omega_distal);
+          tau(k) -=
+              Scalar(0.5) * load.omega_distal.dot(kin.dinertia_dq[static_cast<std::size_t>(k)] *
+                                                  load.omega_distal);
       }
     }
   }
   base.force = F;
-  base.torque = N + kin.r_base_distal.cross(F);
+  if constexpr (has_zero_translation<Segment>::value)
+    base.torque = N;
+  else
+    base.torque = N + kin.r_base_distal.cross(F);
   if constexpr (Segment::has_body) {
     base.force += load.force;
     base.torque += load.torque + kin.r_base_com.cross(load.force);

@@ -57,9 +57,28 @@ inline std::string suggest(const std::string& key, const std::vector<std::string
   return s;
 }
 
+/// \brief Deepest nesting of arrays and objects that parse_robot_json accepts (a
+/// robot description needs 5: top level, segments, segment, pressure_to_torque, row).
+/// Deeper documents are refused while parsing, before any recursion over them.
+inline constexpr std::size_t kMaxJsonDepth = 64;
+
+/// \brief True if `v` has at most `levels` levels of nested arrays/objects (the
+/// recursion is bounded by `levels`, whatever the depth of `v`).
+inline bool nesting_at_most(const nlohmann::json& v, int levels) {
+  if (!v.is_structured()) return true;
+  if (levels <= 0) return false;
+  for (const auto& child : v)
+    if (!nesting_at_most(child, levels - 1)) return false;
+  return true;
+}
+
 /// \brief A short one-line rendering of a JSON value for messages.
 inline std::string describe(const nlohmann::json& v) {
   if (v.is_null()) return "null";
+  // dump() recurses once per level: a value nested thousands of levels deep (possible
+  // through robot_from_json on JSON parsed elsewhere) would overflow the stack.
+  if (!nesting_at_most(v, 16))
+    return std::string(v.type_name()) + " nested more than 16 levels deep";
   std::string d;
   try {
     d = v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
@@ -340,10 +359,17 @@ inline nlohmann::json parse_json_strict(const std::string& text, const std::stri
                                              nlohmann::json& parsed) -> bool {
     switch (event) {
       case Event::object_start:
-        stack.emplace_back(false);
-        break;
       case Event::array_start:
-        stack.emplace_back(true);
+        if (stack.size() >= kMaxJsonDepth) {
+          const std::string p = path(true);
+          throw InputError(Category::Syntax, source,
+                           p.empty()       ? "top level"
+                           : p.size() > 60 ? p.substr(0, 60) + "..."
+                                           : p,
+                           "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                               " levels of arrays and objects (a robot description needs 5)");
+        }
+        stack.emplace_back(event == Event::array_start);
         break;
       case Event::key: {
         Frame& f = stack.back();

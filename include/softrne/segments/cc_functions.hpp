@@ -15,98 +15,136 @@
 /// placed where the closed form has lost at most about two digits to cancellation and the
 /// series converges to full precision with a fixed number of terms; both sides agree to about
 /// 1e-15 relative (tested, including first derivatives across the switch).
+///
+/// Below the switch only \f$g_6\f$ and \f$g_7\f$ are summed; everything else follows from
+/// three exact identities of the series, none of which divides by y:
+/// - \f$g_k = 1/k! - y\,g_{k+2}\f$ (downward, stable for y < 1: the subtracted term is at most
+///   \f$1/((k+1)(k+2))\f$ of the result),
+/// - \f$g_k' = (k\,g_{k+2} - g_{k+1})/2\f$ and \f$g_k'' = (k\,g_{k+2}' - g_{k+1}')/2\f$,
+/// - \f$d_k(x) = 4g_{k+2}(4x) - g_{k+2}(x)\f$, \f$d_k'(x) = 16g_{k+2}'(4x) - g_{k+2}'(x)\f$
+///   (from the first identity; no cancellation: the two terms have ratio 4 and 16 at x = 0).
+/// When both x and 4x are below the switch, no trigonometric function is evaluated at all.
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 
 namespace softrne {
 namespace detail {
 
-/// Number of series terms: for arguments below 1, the first dropped term is below
-/// 1/(2N)! = 1/28! ~ 3e-30, enough for long double.
-constexpr int kCCSeriesTerms = 14;
-
 /// Switch point in \f$y = \phi^2\f$ between series and closed form for \f$g_k\f$.
 constexpr double kCCSeriesSwitch = 1.0;
-/// Switch point in \f$x\f$ for \f$d_k(x)\f$ (its series has terms in \f$(4x)^n\f$).
+/// Switch point in \f$x\f$ for \f$d_k(x)\f$ (it needs \f$g_k\f$ at 4x).
 constexpr double kCCDiffSwitch = 0.25;
 
-constexpr long double factorial(int n) { return n <= 1 ? 1.0L : n * factorial(n - 1); }
-
-/// Series coefficients of the m-th derivative of \f$g_k\f$ (diff = false) or of
-/// \f$d_k\f$ (diff = true), in increasing powers of the argument.
-template <int K, int M, bool Diff>
-struct CCSeries {
-  static constexpr std::array<long double, kCCSeriesTerms> make() {
-    std::array<long double, kCCSeriesTerms> c{};
-    for (int j = 0; j < kCCSeriesTerms; ++j) {
-      // g_k: power y^j of the m-th derivative comes from n = j + m.
-      // d_k: d_k = sum_{n>=1} (-1)^n (1-4^n) x^{n-1}/(2n+k)!, so power j comes from n = j+m+1.
-      const int n = Diff ? j + M + 1 : j + M;
-      long double falling = 1.0L;  // (power+m)!/power!
-      const int power = Diff ? n - 1 : n;
-      for (int i = 0; i < M; ++i) falling *= static_cast<long double>(power - i);
-      long double sign = (n % 2 == 0) ? 1.0L : -1.0L;
-      long double pow4 = 1.0L;
-      for (int i = 0; i < n; ++i) pow4 *= 4.0L;
-      const long double weight = Diff ? (1.0L - pow4) : 1.0L;
-      c[j] = sign * weight * falling / factorial(2 * n + K);
-    }
-    return c;
-  }
-  static constexpr std::array<long double, kCCSeriesTerms> coeffs = make();
-};
-
-template <int K, int M, bool Diff, class Scalar>
-Scalar cc_series(const Scalar& y) {
-  using Real = typename Eigen::NumTraits<Scalar>::Real;
-  const auto& c = CCSeries<K, M, Diff>::coeffs;
-  Scalar acc = Scalar(Real(c[kCCSeriesTerms - 1]));
-  for (int j = kCCSeriesTerms - 2; j >= 0; --j) acc = acc * y + Scalar(Real(c[j]));
-  return acc;
+constexpr long double factorial(int n) {
+  return n <= 1 ? 1.0L : n * factorial(n - 1);
 }
 
-/// \brief \f$g_1, g_2, g_3\f$ and their first two derivatives at one argument.
+/// Capacity of the coefficient tables (double needs 8 terms, long double 9).
+constexpr int kCCMaxSeriesTerms = 16;
+
+/// Number of terms of the series of \f$g_6\f$ (and \f$g_7\f$) on \f$0 \le y < 1\f$ for the
+/// precision of Real: the first dropped term, relative to \f$g_6 \ge g_6(1) > 6!^{-1}/1.1\f$,
+/// is below eps/16 (double: 8 terms, long double: 9).
+template <class Real>
+constexpr int cc_series_terms() {
+  const long double eps = static_cast<long double>(std::numeric_limits<Real>::epsilon());
+  int n = 1;
+  while (n < kCCMaxSeriesTerms && 1.1L * factorial(6) / factorial(2 * n + 6) >= eps / 16) ++n;
+  return n;
+}
+
+/// Coefficients \f$(-1)^n/(2n+K)!\f$ of \f$g_K\f$.
+template <int K>
+struct CCSeries {
+  static constexpr std::array<long double, kCCMaxSeriesTerms> make() {
+    std::array<long double, kCCMaxSeriesTerms> c{};
+    for (int n = 0; n < kCCMaxSeriesTerms; ++n)
+      c[static_cast<std::size_t>(n)] = (n % 2 == 0 ? 1.0L : -1.0L) / factorial(2 * n + K);
+    return c;
+  }
+  static constexpr std::array<long double, kCCMaxSeriesTerms> coeffs = make();
+};
+
+/// \f$g_6(y)\f$ and \f$g_7(y)\f$ by their series (Horner, both in one loop), y < 1.
+template <class Scalar>
+void cc_series_g67(const Scalar& y, Scalar& g6, Scalar& g7) {
+  using Real = typename Eigen::NumTraits<Scalar>::Real;
+  constexpr int N = cc_series_terms<Real>();
+  const auto& c6 = CCSeries<6>::coeffs;
+  const auto& c7 = CCSeries<7>::coeffs;
+  g6 = Scalar(Real(c6[N - 1]));
+  g7 = Scalar(Real(c7[N - 1]));
+  for (int j = N - 2; j >= 0; --j) {
+    g6 = g6 * y + Scalar(Real(c6[static_cast<std::size_t>(j)]));
+    g7 = g7 * y + Scalar(Real(c7[static_cast<std::size_t>(j)]));
+  }
+}
+
+/// \brief \f$g_0..g_3\f$ and their first two derivatives at one argument.
 template <class Scalar>
 struct CCFunctions {
   Scalar g[4];    ///< g[k] = g_k, k = 0..3 (g[0] = cos(phi))
   Scalar dg[4];   ///< first derivative with respect to y = phi^2
   Scalar ddg[4];  ///< second derivative with respect to y
+  /// Below the switch only: \f$g_4, g_5\f$ and their first derivatives (for \f$d_k\f$).
+  Scalar g45[2], dg45[2];
 
-  /// \param y \f$\phi^2\f$; \param sin_phi, cos_phi of \f$\phi = \sqrt{y}\f$ (used above the
-  /// switch point only, so callers may pass any value below it).
-  void compute(const Scalar& y, const Scalar& phi, const Scalar& sin_phi, const Scalar& cos_phi) {
-    using std::cos;
-    using std::sin;
-    if (y < Scalar(kCCSeriesSwitch)) {
-      g[0] = cos_phi;
-      g[1] = cc_series<1, 0, false>(y);
-      g[2] = cc_series<2, 0, false>(y);
-      g[3] = cc_series<3, 0, false>(y);
-      dg[1] = cc_series<1, 1, false>(y);
-      dg[2] = cc_series<2, 1, false>(y);
-      dg[3] = cc_series<3, 1, false>(y);
-      ddg[1] = cc_series<1, 2, false>(y);
-      ddg[2] = cc_series<2, 2, false>(y);
-      ddg[3] = cc_series<3, 2, false>(y);
+  /// Below the switch (y < kCCSeriesSwitch): everything from the series of g_6, g_7.
+  /// \param second_derivatives false skips ddg (unused at the argument 4x).
+  void compute_series(const Scalar& y, bool second_derivatives = true) {
+    const Real inv[8] = {Real(1),
+                         Real(1),
+                         Real(1) / Real(2),
+                         Real(1) / Real(6),
+                         Real(1) / Real(24),
+                         Real(1) / Real(120),
+                         Real(1) / Real(720),
+                         Real(1) / Real(5040)};
+    Scalar gg[8];
+    cc_series_g67(y, gg[6], gg[7]);
+    for (int k = 5; k >= 0; --k) gg[k] = Scalar(inv[k]) - y * gg[k + 2];
+    Scalar d[6];  // d[k] = g_k'
+    for (int k = 0; k <= 5; ++k) d[k] = (Scalar(Real(k)) * gg[k + 2] - gg[k + 1]) / Scalar(2);
+    for (int k = 0; k < 4; ++k) {
+      g[k] = gg[k];
+      dg[k] = d[k];
+    }
+    g45[0] = gg[4];
+    g45[1] = gg[5];
+    dg45[0] = d[4];
+    dg45[1] = d[5];
+    if (second_derivatives)
+      for (int k = 0; k < 4; ++k) ddg[k] = (Scalar(Real(k)) * d[k + 2] - d[k + 1]) / Scalar(2);
+  }
+
+  /// At or above the switch: closed forms and the recurrences g_k' = (g_{k-1} - k g_k) / (2y),
+  /// g_k'' = (g_{k-1}' - (k+2) g_k') / (2y), g_0' = -g_1/2.
+  /// \param phi \f$\sqrt y\f$ (y the argument), \param inv_y 1/y, \param inv_phi 1/phi (the caller
+  /// forms them with one division), \param sin_phi, cos_phi the sine and cosine of phi. \param
+  /// second_derivatives false (the argument 4x) skips ddg and dg[0], dg[1].
+  void compute_closed(const Scalar& phi, const Scalar& inv_y, const Scalar& inv_phi,
+                      const Scalar& sin_phi, const Scalar& cos_phi,
+                      bool second_derivatives = true) {
+    g[0] = cos_phi;
+    g[1] = sin_phi * inv_phi;
+    g[2] = (Scalar(1) - cos_phi) * inv_y;
+    g[3] = (phi - sin_phi) * inv_y * inv_phi;
+    const Scalar half_inv_y = Scalar(0.5) * inv_y;
+    for (int k = second_derivatives ? 1 : 2; k <= 3; ++k)
+      dg[k] = (g[k - 1] - Scalar(k) * g[k]) * half_inv_y;
+    if (second_derivatives) {
       dg[0] = -g[1] / Scalar(2);
       ddg[0] = -dg[1] / Scalar(2);
-      return;
+      for (int k = 1; k <= 3; ++k) ddg[k] = (dg[k - 1] - Scalar(k + 2) * dg[k]) * half_inv_y;
     }
-    // Closed forms and the recurrences g_k' = (g_{k-1} - k g_k) / (2y),
-    // g_k'' = (g_{k-1}' - (k+2) g_k') / (2y), g_0' = -g_1/2.
-    g[0] = cos_phi;
-    g[1] = sin_phi / phi;
-    g[2] = (Scalar(1) - cos_phi) / y;
-    g[3] = (phi - sin_phi) / (y * phi);
-    const Scalar two_y = Scalar(2) * y;
-    dg[0] = -g[1] / Scalar(2);
-    for (int k = 1; k <= 3; ++k) dg[k] = (g[k - 1] - Scalar(k) * g[k]) / two_y;
-    ddg[0] = -dg[1] / Scalar(2);
-    for (int k = 1; k <= 3; ++k) ddg[k] = (dg[k - 1] - Scalar(k + 2) * dg[k]) / two_y;
   }
+
+ private:
+  using Real = typename Eigen::NumTraits<Scalar>::Real;
 };
 
 /// \brief Everything the CC joint needs at \f$x = u^2 + v^2\f$: \f$g_k(x)\f$ with two
@@ -114,35 +152,42 @@ struct CCFunctions {
 template <class Scalar>
 struct CCArcFunctions {
   CCFunctions<Scalar> at_x;   ///< arguments x
-  CCFunctions<Scalar> at_4x;  ///< arguments 4x (only g and dg of index 2, 3 are used)
+  CCFunctions<Scalar> at_4x;  ///< arguments 4x (only g and dg of index 2, 3 are set)
   Scalar d2, d3;              ///< d_k(x) = (g_k(x) - g_k(4x)) / x
   Scalar dd2, dd3;            ///< derivatives of d_k with respect to x
-  Scalar sin_phi, cos_phi;
 
   void compute(const Scalar& x) {
     using std::cos;
     using std::sin;
     using std::sqrt;
-    const bool zero = !(x > Scalar(0));
-    const Scalar phi = zero ? Scalar(0) : Scalar(sqrt(x));
-    sin_phi = sin(phi);
-    cos_phi = cos(phi);
-    at_x.compute(x, phi, sin_phi, cos_phi);
-    // Double angle: sin(2 phi) = 2 S C, cos(2 phi) = 1 - 2 S^2.
     const Scalar x4 = Scalar(4) * x;
-    at_4x.compute(x4, Scalar(2) * phi, Scalar(2) * sin_phi * cos_phi,
-                  Scalar(1) - Scalar(2) * sin_phi * sin_phi);
     if (x < Scalar(kCCDiffSwitch)) {
-      d2 = cc_series<2, 0, true>(x);
-      d3 = cc_series<3, 0, true>(x);
-      dd2 = cc_series<2, 1, true>(x);
-      dd3 = cc_series<3, 1, true>(x);
-    } else {
-      d2 = (at_x.g[2] - at_4x.g[2]) / x;
-      d3 = (at_x.g[3] - at_4x.g[3]) / x;
-      dd2 = (at_x.dg[2] - Scalar(4) * at_4x.dg[2] - d2) / x;
-      dd3 = (at_x.dg[3] - Scalar(4) * at_4x.dg[3] - d3) / x;
+      // x and 4x below the series switch: no trigonometry, d_k without a quotient.
+      at_x.compute_series(x);
+      at_4x.compute_series(x4, false);
+      d2 = Scalar(4) * at_4x.g45[0] - at_x.g45[0];
+      d3 = Scalar(4) * at_4x.g45[1] - at_x.g45[1];
+      dd2 = Scalar(16) * at_4x.dg45[0] - at_x.dg45[0];
+      dd3 = Scalar(16) * at_4x.dg45[1] - at_x.dg45[1];
+      return;
     }
+    const Scalar phi = sqrt(x);
+    const Scalar sin_phi = sin(phi);
+    const Scalar cos_phi = cos(phi);
+    const Scalar inv_x = Scalar(1) / x;  // the only division
+    const Scalar inv_phi = phi * inv_x;
+    if (x < Scalar(kCCSeriesSwitch))
+      at_x.compute_series(x);
+    else
+      at_x.compute_closed(phi, inv_x, inv_phi, sin_phi, cos_phi);
+    // Double angle: sin(2 phi) = 2 S C, cos(2 phi) = 1 - 2 S^2.
+    at_4x.compute_closed(Scalar(2) * phi, Scalar(0.25) * inv_x, Scalar(0.5) * inv_phi,
+                         Scalar(2) * sin_phi * cos_phi, Scalar(1) - Scalar(2) * sin_phi * sin_phi,
+                         false);
+    d2 = (at_x.g[2] - at_4x.g[2]) * inv_x;
+    d3 = (at_x.g[3] - at_4x.g[3]) * inv_x;
+    dd2 = (at_x.dg[2] - Scalar(4) * at_4x.dg[2] - d2) * inv_x;
+    dd3 = (at_x.dg[3] - Scalar(4) * at_4x.dg[3] - d3) * inv_x;
   }
 };
 

@@ -2,6 +2,7 @@
 /// \file
 /// \brief Pneumatic constant-curvature (CC) continuum joint, paper section III-A.
 
+#include <array>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -44,9 +45,9 @@ struct ConstantCurvatureJoint {
   /// inline (no heap).
   using PressureMap = Eigen::Matrix<Scalar, 2, Eigen::Dynamic, 0, 2, max_chambers>;
 
-  Scalar mass{1};      ///< m, kg
-  Scalar height{0.2};  ///< h, arc length, m
-  Scalar diameter{0.2};  ///< D, disk diameter, m
+  Scalar mass{1};                       ///< m, kg
+  Scalar height{0.2};                   ///< h, arc length, m
+  Scalar diameter{0.2};                 ///< D, disk diameter, m
   Vector2 stiffness = Vector2::Zero();  ///< diagonal of K_spring, N m/rad
   Vector2 damping = Vector2::Zero();    ///< diagonal of K_d, N m s/rad
   PressureMap pressure_to_torque = four_chamber_map(Scalar(0.06), Scalar(0.03));  ///< K_prs
@@ -70,65 +71,79 @@ struct ConstantCurvatureJoint {
   }
 
   /// \brief Fills kin for configuration q and velocity qdot (both of size 2).
+  ///
+  /// Written out per component: with w = (u, v, 0) every product of [w]x with itself or
+  /// with e_z has a closed form, so no 3x3 matrix product is formed.
   template <class Q, class Qd>
   void calc(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
             Kinematics& kin) const {
     const Scalar u = q(0), v = q(1);
     const Scalar ud = qdot(0), vd = qdot(1);
-    const Scalar x = u * u + v * v;  // phi^2
+    const Scalar uu = u * u, vv = v * v, uv = u * v;
+    const Scalar x = uu + vv;  // phi^2
     detail::CCArcFunctions<Scalar> f;
     f.compute(x);
     const auto& g = f.at_x.g;
     const auto& dg = f.at_x.dg;
     const auto& ddg = f.at_x.ddg;
 
-    const Vector3 w(u, v, Scalar(0));        // rotation vector of the distal frame
-    const Vector3 w_perp(v, -u, Scalar(0));  // in-plane direction the arc bends towards
-    const Vector3 wd(ud, vd, Scalar(0));
-    const Vector3 wd_perp(vd, -ud, Scalar(0));
-    const Vector3 ez = Vector3::UnitZ();
-    const Scalar s = u * ud + v * vd;     // (1/2) d(phi^2)/dt
-    const Scalar wd2 = ud * ud + vd * vd;
+    // Eq. 2 is Rodrigues' formula for the rotation vector w = (u, v, 0):
+    // R = I + g1 [w]x + g2 [w]x^2 with [w]x^2 = w w^T - x I.
+    Matrix3& R = kin.R_base_distal;
+    R(0, 0) = Scalar(1) - g[2] * vv;
+    R(0, 1) = g[2] * uv;
+    R(0, 2) = g[1] * v;
+    R(1, 0) = g[2] * uv;
+    R(1, 1) = Scalar(1) - g[2] * uu;
+    R(1, 2) = -g[1] * u;
+    R(2, 0) = -g[1] * v;
+    R(2, 1) = g[1] * u;
+    R(2, 2) = Scalar(1) - g[2] * x;
 
-    // Eq. 2 is Rodrigues' formula for the rotation vector w = (u, v, 0).
-    const Matrix3 W = skew(w);
-    const Matrix3 W2 = W * W;
-    kin.R_base_distal = Matrix3::Identity() + g[1] * W + g[2] * W2;
-
-    // Eqs. 3-4 and 9: r = h (A(x) w_perp + B(x) e_z) with (A, B) = (g2, g1) for the distal
-    // end and (g3, g2) for the centre of mass. Their Jacobians and Jdot*qdot follow from
-    // d/dq_j A(x) = 2 A'(x) q_j.
+    // Eqs. 3-4 and 9: r = h (A(x) w_perp + B(x) e_z), w_perp = (v, -u, 0), with (A, B) =
+    // (g2, g1) for the distal end and (g3, g2) for the centre of mass. Their Jacobians and
+    // Jdot*qdot follow from d/dq_j A(x) = 2 A'(x) q_j; s = (1/2) d(phi^2)/dt.
     const Scalar h = height;
-    auto position = [&](int a, int b, Eigen::Ref<Vector3> r, Eigen::Ref<Eigen::Matrix<Scalar, 3, 2>> J,
-                        Eigen::Ref<Vector3> Jdot_qdot) {
-      r = h * (g[a] * w_perp + g[b] * ez);
-      const Vector3 common = Scalar(2) * (dg[a] * w_perp + dg[b] * ez);
-      J.col(0) = h * (common * u + g[a] * Vector3(0, -1, 0).template cast<Scalar>());
-      J.col(1) = h * (common * v + g[a] * Vector3(1, 0, 0).template cast<Scalar>());
-      Jdot_qdot = h * ((Scalar(4) * ddg[a] * s * s + Scalar(2) * dg[a] * wd2) * w_perp +
-                       Scalar(4) * dg[a] * s * wd_perp +
-                       (Scalar(4) * ddg[b] * s * s + Scalar(2) * dg[b] * wd2) * ez);
+    const Scalar s = u * ud + v * vd;
+    const Scalar wd2 = ud * ud + vd * vd;
+    const Scalar ss4 = Scalar(4) * s * s;
+    auto position = [&](int a, int b, Vector3& r, auto&& J, auto&& Jdot_qdot) {
+      r = Vector3(h * g[a] * v, -h * g[a] * u, h * g[b]);
+      const Scalar ca = Scalar(2) * h * dg[a], cb = Scalar(2) * h * dg[b];
+      J(0, 0) = ca * uv;
+      J(1, 0) = -ca * uu - h * g[a];
+      J(2, 0) = cb * u;
+      J(0, 1) = ca * vv + h * g[a];
+      J(1, 1) = -ca * uv;
+      J(2, 1) = cb * v;
+      // h ((4 A'' s^2 + 2 A' |wd|^2) w_perp + 4 A' s wd_perp + (4 B'' s^2 + 2 B' |wd|^2) e_z)
+      const Scalar A = h * (ss4 * ddg[a] + Scalar(2) * dg[a] * wd2);
+      const Scalar Bs = Scalar(2) * ca * s;
+      Jdot_qdot(0) = A * v + Bs * vd;
+      Jdot_qdot(1) = -A * u - Bs * ud;
+      Jdot_qdot(2) = h * (ss4 * ddg[b] + Scalar(2) * dg[b] * wd2);
     };
-    Eigen::Matrix<Scalar, 3, 2> Je_lin;
-    Vector3 Jdot_e_lin;
-    position(2, 1, kin.r_base_distal, Je_lin, Jdot_e_lin);
+    position(2, 1, kin.r_base_distal, kin.J_distal, kin.Jdot_qdot_distal);
     position(3, 2, kin.r_base_com, kin.J_com, kin.Jdot_qdot_com);
 
     // Angular velocity omega = J_l(w) wdot with the SO(3) left Jacobian
-    // J_l = I + g2 [w]x + g3 [w]x^2 (the angular rows of eq. 6).
-    const Matrix3 Jl = Matrix3::Identity() + g[2] * W + g[3] * W2;
-    kin.J_distal.template topRows<3>() = Je_lin;
-    kin.J_distal.template bottomRows<3>() = Jl.template leftCols<2>();
+    // J_l = I + g2 [w]x + g3 [w]x^2 (the angular rows of eq. 6); only its first two columns.
+    kin.J_distal(3, 0) = Scalar(1) - g[3] * vv;
+    kin.J_distal(4, 0) = g[3] * uv;
+    kin.J_distal(5, 0) = -g[2] * v;
+    kin.J_distal(3, 1) = g[3] * uv;
+    kin.J_distal(4, 1) = Scalar(1) - g[3] * uu;
+    kin.J_distal(5, 1) = g[2] * u;
     // Eq. 8 applied to wdot: (dJ_l/dt) wdot = 2s g2' w x wd + 2s g3' w x (w x wd)
-    //                                        + g3 wd x (w x wd).
-    const Vector3 w_x_wd = w.cross(wd);
-    kin.Jdot_qdot_distal.template head<3>() = Jdot_e_lin;
-    kin.Jdot_qdot_distal.template tail<3>() = Scalar(2) * s * dg[2] * w_x_wd +
-                                              Scalar(2) * s * dg[3] * w.cross(w_x_wd) +
-                                              g[3] * wd.cross(w_x_wd);
+    //                                        + g3 wd x (w x wd),
+    // with w x wd = c e_z, w x e_z = w_perp, wd x e_z = wd_perp.
+    const Scalar c = u * vd - v * ud;
+    const Scalar t3 = Scalar(2) * s * dg[3] * c, g3c = g[3] * c;
+    kin.Jdot_qdot_distal(3) = t3 * v + g3c * vd;
+    kin.Jdot_qdot_distal(4) = -t3 * u - g3c * ud;
+    kin.Jdot_qdot_distal(5) = Scalar(2) * s * dg[2] * c;
 
-    calc_inertia(f, u, v, w_perp, kin);
-    kin.inertia_rate = kin.dinertia_dq[0] * ud + kin.dinertia_dq[1] * vd;
+    calc_inertia(f, u, v, ud, vd, kin);
   }
 
   /// \brief Generalised forces of the chamber pressures (eq. 24 or a custom layout).
@@ -154,9 +169,12 @@ struct ConstantCurvatureJoint {
   /// \f$I^b = s_0 \mathbf 1 + a_w w_\perp w_\perp^T + a_{wz}(w_\perp e_z^T + e_z w_\perp^T)
   /// + a_z e_z e_z^T\f$: the disks' own inertia (eq. 20) averaged over the arc, plus the
   /// parallel-axis terms of eqs. 21-22 integrated analytically, minus those of the centre of
-  /// mass. Then \f$I^i = R^T I^b R\f$ (eq. 19).
+  /// mass. Then \f$I^i = R^T I^b R\f$ (eq. 19), formed directly in the distal frame from
+  /// \f$p = R^T w_\perp = (g_0 v, -g_0 u, g_1 x)\f$ and \f$e = R^T e_z = (-g_1 v, g_1 u, g_0)\f$
+  /// (R turns the plane of \f$w_\perp\f$ and \f$e_z\f$ about w, which it leaves fixed).
+  /// Also fills dinertia_dq and inertia_rate.
   void calc_inertia(const detail::CCArcFunctions<Scalar>& f, const Scalar& u, const Scalar& v,
-                    const Vector3& w_perp, Kinematics& kin) const {
+                    const Scalar& ud, const Scalar& vd, Kinematics& kin) const {
     const auto& g = f.at_x.g;
     const auto& dg = f.at_x.dg;
     const Scalar x = u * u + v * v;
@@ -168,38 +186,80 @@ struct ConstantCurvatureJoint {
     const Scalar s0 = md + Scalar(2) * mh * g[3] - mh * (x * g[3] * g[3] + g[2] * g[2]);
     const Scalar a_w = Scalar(2) * md * G3 - Scalar(2) * mh * f.d3 + mh * g[3] * g[3];
     const Scalar a_wz = md * G2 - mh * f.d2 + mh * g[3] * g[2];
-    const Scalar a_z = md * (Scalar(1) - Scalar(2) * x * G3) - Scalar(2) * mh * G3 + mh * g[2] * g[2];
+    const Scalar a_z =
+        md * (Scalar(1) - Scalar(2) * x * G3) - Scalar(2) * mh * G3 + mh * g[2] * g[2];
 
     const Scalar ds0 = Scalar(2) * mh * dg[3] -
                        mh * (g[3] * g[3] + Scalar(2) * x * g[3] * dg[3] + Scalar(2) * g[2] * dg[2]);
-    const Scalar da_w = Scalar(2) * md * dG3 - Scalar(2) * mh * f.dd3 + Scalar(2) * mh * g[3] * dg[3];
+    const Scalar da_w =
+        Scalar(2) * md * dG3 - Scalar(2) * mh * f.dd3 + Scalar(2) * mh * g[3] * dg[3];
     const Scalar da_wz = md * dG2 - mh * f.dd2 + mh * (dg[3] * g[2] + g[3] * dg[2]);
     const Scalar da_z = md * (-Scalar(2) * G3 - Scalar(2) * x * dG3) - Scalar(2) * mh * dG3 +
                         Scalar(2) * mh * g[2] * dg[2];
 
-    const Vector3 ez = Vector3::UnitZ();
-    const Matrix3 WW = w_perp * w_perp.transpose();
-    const Matrix3 WZ = w_perp * ez.transpose() + ez * w_perp.transpose();
-    const Matrix3 ZZ = ez * ez.transpose();
-    const Matrix3 Ib = s0 * Matrix3::Identity() + a_w * WW + a_wz * WZ + a_z * ZZ;
-    const Matrix3 dIb_dx = ds0 * Matrix3::Identity() + da_w * WW + da_wz * WZ + da_z * ZZ;
-
     const Matrix3& R = kin.R_base_distal;
-    kin.inertia_com = R.transpose() * Ib * R;
-
-    // dI^i/dq_j = R^T (dI^b/dq_j + I^b [w_j]x - [w_j]x I^b) R with w_j the j-th angular
-    // Jacobian column, since dR/dq_j = [w_j]x R.
-    const Vector3 dwperp[2] = {Vector3(Scalar(0), Scalar(-1), Scalar(0)),
-                               Vector3(Scalar(1), Scalar(0), Scalar(0))};
-    const Scalar qj[2] = {u, v};
-    for (int j = 0; j < 2; ++j) {
-      const Matrix3 dIb = Scalar(2) * qj[j] * dIb_dx +
-                          a_w * (dwperp[j] * w_perp.transpose() + w_perp * dwperp[j].transpose()) +
-                          a_wz * (dwperp[j] * ez.transpose() + ez * dwperp[j].transpose());
-      const Matrix3 Wj = skew(kin.J_distal.template bottomRows<3>().col(j));
-      kin.dinertia_dq[static_cast<std::size_t>(j)] =
-          R.transpose() * (dIb + Ib * Wj - Wj * Ib) * R;
+    const Scalar c0 = R(2, 2);  // = g0 = cos(phi), as R computes it
+    const Vector3 p(c0 * v, -c0 * u, g[1] * x);
+    const Vector3 e = R.row(2).transpose();
+    // Symmetric matrices as their 6 entries (xx, yy, zz, xy, xz, yz).
+    const Sym PP = outer(p), EE = outer(e), PE = sym(p, e);
+    Sym I, D;  // I^i, and R^T (dI^b/dx) R
+    for (int k = 0; k < 6; ++k) {
+      I[k] = a_w * PP[k] + a_wz * PE[k] + a_z * EE[k];
+      D[k] = da_w * PP[k] + da_wz * PE[k] + da_z * EE[k];
     }
+    for (int k = 0; k < 3; ++k) {
+      I[k] += s0;
+      D[k] += ds0;
+    }
+    to_matrix(I, kin.inertia_com);
+
+    // dI^i/dq_j = R^T (dI^b/dq_j) R + I^i [w'_j]x - [w'_j]x I^i, since dR/dq_j = [w_j]x R with
+    // w_j the j-th angular Jacobian column and w'_j = R^T w_j the j-th column of the right
+    // Jacobian J_r = R^T J_l = I - g2 [w]x + g3 [w]x^2; R^T dw_perp/dq_j = R^T (-e_y), R^T e_x.
+    const Scalar qj[2] = {u, v};
+    const Vector3 dp[2] = {-R.row(1).transpose(), R.row(0).transpose()};
+    const Vector3 wr[2] = {Vector3(Scalar(1) - g[3] * v * v, g[3] * u * v, g[2] * v),
+                           Vector3(g[3] * u * v, Scalar(1) - g[3] * u * u, -g[2] * u)};
+    Sym rate;
+    for (int j = 0; j < 2; ++j) {
+      const Sym C = commutator(I, wr[j]), Sp = sym(dp[j], p), Se = sym(dp[j], e);
+      const Scalar two_q = Scalar(2) * qj[j];
+      Sym dI;
+      for (int k = 0; k < 6; ++k) dI[k] = two_q * D[k] + a_w * Sp[k] + a_wz * Se[k] + C[k];
+      to_matrix(dI, kin.dinertia_dq[static_cast<std::size_t>(j)]);
+      if (j == 0)
+        for (int k = 0; k < 6; ++k) rate[k] = dI[k] * ud;
+      else
+        for (int k = 0; k < 6; ++k) rate[k] += dI[k] * vd;
+    }
+    to_matrix(rate, kin.inertia_rate);
+  }
+
+  /// A symmetric 3x3 matrix as (xx, yy, zz, xy, xz, yz).
+  using Sym = std::array<Scalar, 6>;
+  static Sym outer(const Vector3& a) {  // a a^T
+    return {a(0) * a(0), a(1) * a(1), a(2) * a(2), a(0) * a(1), a(0) * a(2), a(1) * a(2)};
+  }
+  static Sym sym(const Vector3& a, const Vector3& b) {  // a b^T + b a^T
+    return {Scalar(2) * a(0) * b(0),   Scalar(2) * a(1) * b(1),   Scalar(2) * a(2) * b(2),
+            a(0) * b(1) + a(1) * b(0), a(0) * b(2) + a(2) * b(0), a(1) * b(2) + a(2) * b(1)};
+  }
+  /// \f$I[w]_\times - [w]_\times I\f$ for symmetric I (symmetric: \f$A + A^T\f$, \f$A =
+  /// I[w]_\times\f$).
+  static Sym commutator(const Sym& I, const Vector3& w) {
+    const Scalar &xx = I[0], &yy = I[1], &zz = I[2], &xy = I[3], &xz = I[4], &yz = I[5];
+    return {Scalar(2) * (w(2) * xy - w(1) * xz),      Scalar(2) * (w(0) * yz - w(2) * xy),
+            Scalar(2) * (w(1) * xz - w(0) * yz),      w(2) * (yy - xx) + w(0) * xz - w(1) * yz,
+            w(1) * (xx - zz) - w(0) * xy + w(2) * yz, w(0) * (zz - yy) + w(1) * xy - w(2) * xz};
+  }
+  static void to_matrix(const Sym& s, Matrix3& m) {
+    m(0, 0) = s[0];
+    m(1, 1) = s[1];
+    m(2, 2) = s[2];
+    m(0, 1) = m(1, 0) = s[3];
+    m(0, 2) = m(2, 0) = s[4];
+    m(1, 2) = m(2, 1) = s[5];
   }
 };
 

@@ -1,15 +1,30 @@
 #pragma once
 /// \file
 /// \brief Simulating an arm from recorded pressures with CVODE (BDF), Jacobian by AutoDiff.
+///
+/// Tolerances. The state is x = [q, qdot, effect states]. CVODE's absolute tolerance
+/// `cvode.atol` applies to the angles q (rad) and the effect states; the velocities get
+/// `cvode.atol * velocity_atol_factor` (rad/s). The defaults (rtol 1e-6, atol 1e-4 rad,
+/// velocities 1e-2 rad/s) keep the simulated angles within about 5e-4 rad of the converged
+/// solution on the bundled arm (examples/data/arm-a-1/test.csv, 14 s), six times below the
+/// angle sensors' noise (3e-3 rad) and far below the model error (0.1 rad), while not
+/// resolving the 1e-5 rad, 3e-3 rad/s wiggles that the 300 Pa sensor noise of recorded
+/// pressures drives at 50-100 Hz: at atol 1e-8 those cost 14 times the steps (34k instead of
+/// 2.5k). Tighten them for verification (tools/softrne-sim --help).
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <utility>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
+#include "softrne/algorithms/rnea.hpp"
 #include "softrne/model/arm_model.hpp"
 #include "softrne/sim/cvode.hpp"
 #include "softrne/sim/input_signal.hpp"
@@ -19,13 +34,38 @@ namespace softrne::sim {
 
 /// \brief Settings of simulate_arm.
 struct ArmSimulationOptions {
-  CvodeOptions cvode{};
+  /// Integrator settings. Defaults here: rtol 1e-6, atol 1e-4 (rad, for the angles; see the
+  /// file comment), CvodeOptions' defaults otherwise.
+  CvodeOptions cvode = default_cvode();
   /// How recorded pressures are read between samples (see PressureInterpolation).
   enum class PressureInterpolation { pchip, linear, zero_order_hold };
   PressureInterpolation interpolation = PressureInterpolation::pchip;
   /// Jacobian of the state equation by forward-mode AutoDiff through the templated RNE
   /// (exact); false: CVODE's internal finite differences.
   bool autodiff_jacobian = true;
+  /// How the AutoDiff Jacobian is formed (both exact; see ArmSystem::JacobianMethod).
+  enum class JacobianMethod { inverse_dynamics, forward_dynamics };
+  JacobianMethod jacobian_method = JacobianMethod::inverse_dynamics;
+  /// Absolute tolerance of the velocities = cvode.atol * velocity_atol_factor (1/s): a
+  /// velocity error dv moves the angles by about dv / omega for a mode of frequency omega.
+  /// 1 gives every state the same atol.
+  double velocity_atol_factor = 100.0;
+  /// OPTIONAL input pre-smoothing, off (0) by default: the standard deviation (s) of a
+  /// Gaussian kernel applied to the recorded pressures before they are interpolated
+  /// (smooth_pressures). It changes the model's input (and so the result): it removes sensor
+  /// noise that the integrator would otherwise resolve, at the price of rounding off pressure
+  /// steps and delaying nothing (zero phase). With it on, no restarts are made at steps.
+  double pressure_smoothing = 0.0;
+  /// Called now and then (every 64 right-hand-side evaluations) with the integrator's time;
+  /// for progress indicators. Empty: never.
+  std::function<void(double t)> progress;
+
+  static CvodeOptions default_cvode() {
+    CvodeOptions c;
+    c.rtol = 1e-6;
+    c.atol = 1e-4;
+    return c;
+  }
 };
 
 /// \brief Result: measured-space angles (simulated q plus any angle offset) on the input grid.
@@ -62,14 +102,58 @@ inline std::vector<double> pressure_jumps(const Eigen::VectorXd& t, const Eigen:
   return out;
 }
 
-/// \brief The arm as an ODE system for CVODE: x' = f(t, x) with the pressures of an
-/// InputSignal, and its exact Jacobian by AutoDiff (blocks of kBlock directions at a time).
+/// \brief Zero-phase Gaussian smoothing of sampled signals (one column per channel), for
+/// ArmSimulationOptions::pressure_smoothing: row i becomes the weighted mean of the rows j with
+/// weights exp(-(t_j - t_i)^2 / (2 sigma^2)) - exp(-8), cut off at |t_j - t_i| = 4 sigma where
+/// they reach zero (so that rounding in the window bounds cannot matter), renormalised at the
+/// ends. Works on irregular grids; non-negative weights, so no overshoot at pressure steps.
+/// sigma <= 0 returns the input. Cost O(N * window).
+inline Eigen::MatrixXd smooth_pressures(const Eigen::VectorXd& t, const Eigen::MatrixXd& p,
+                                        double sigma) {
+  if (!(sigma > 0) || t.size() < 2) return p;
+  const Eigen::Index n = t.size();
+  Eigen::MatrixXd out(p.rows(), p.cols());
+  const double reach = 4 * sigma, inv2s2 = 1.0 / (2 * sigma * sigma), floor = std::exp(-8.0);
+  Eigen::Index lo = 0, hi = 0;  // window [lo, hi) around sample i
+  for (Eigen::Index i = 0; i < n; ++i) {
+    while (t(lo) < t(i) - reach) ++lo;
+    while (hi < n && t(hi) <= t(i) + reach) ++hi;
+    double wsum = 0;
+    out.row(i).setZero();
+    for (Eigen::Index j = lo; j < hi; ++j) {
+      const double dt = t(j) - t(i);
+      const double w = std::max(0.0, std::exp(-dt * dt * inv2s2) - floor);
+      out.row(i) += w * p.row(j);
+      wsum += w;
+    }
+    out.row(i) /= wsum;  // >= the weight of j = i, 1 - exp(-8)
+  }
+  return out;
+}
+
+/// \brief The arm as an ODE system for CVODE: x' = f(t, x) with the interpolated recorded
+/// pressures, and its exact Jacobian by AutoDiff (blocks of kBlock directions at a time).
 class ArmSystem {
  public:
-  static constexpr int kBlock = 4;
+  /// Derivative directions per AutoDiff pass. 2 (one SSE register) measured fastest for the
+  /// 12-state bundled arm: 0.43M instructions per Jacobian against 0.67M with 4, 0.73M with 12.
+  static constexpr int kBlock = 2;
   using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, kBlock, 1>>;
+  using ADVector = Eigen::Matrix<AD, Eigen::Dynamic, 1>;
 
-  /// \param smooth true: PCHIP (C1); false: `input`'s own linear or zero-order hold.
+  /// \brief How jacobian() differentiates the acceleration rows; both are exact (AutoDiff).
+  /// - inverse_dynamics: \f$\partial\ddot q/\partial x = M^{-1}(\partial\tau/\partial x -
+  ///   \partial\,\mathrm{ID}(q,\dot q,\ddot q^*)/\partial x)\f$ at the current acceleration
+  ///   \f$\ddot q^*\f$, with ID the chain's RNE (M qddot + C qdot + G) and tau every other
+  ///   force (pressures, springs, dampers, effects). AutoDiff runs through one kinematics pass
+  ///   and one RNE pass per block; M's Cholesky factor comes from a double evaluation. 1.3 to
+  ///   2 times cheaper than differentiating forward dynamics (the default).
+  /// - forward_dynamics: AutoDiff through the whole right-hand side (kinematics, nq + 1 RNE
+  ///   passes, Cholesky).
+  using JacobianMethod = ArmSimulationOptions::JacobianMethod;
+
+  /// \param t, pressures the recorded samples (N, N x num_inputs)
+  /// \param mode PCHIP (C1, no overshoot), linear, or zero-order hold between samples
   ArmSystem(const ArmDescription& desc, const Eigen::VectorXd& t, const Eigen::MatrixXd& pressures,
             ArmSimulationOptions::PressureInterpolation mode)
       : desc_(desc),
@@ -81,23 +165,41 @@ class ArmSystem {
                    ? Interpolation::zero_order_hold
                    : Interpolation::linear),
         pchip_(t, pressures) {
+    const int nq = desc.nq, ns = desc.num_states();
     p_.resize(desc.num_inputs);
-    x_ad_.resize(desc.num_states());
-    xd_ad_.resize(desc.num_states());
+    x_ad_.resize(ns);
+    xd_ad_.resize(ns);
+    q_ad_.resize(nq);
+    v_ad_.resize(nq);
+    a_ad_.resize(nq);
+    p_ad_.resize(desc.num_inputs);
+    xdot_.resize(ns);
+    dr_.resize(nq, kBlock);
   }
 
   int size() const { return desc_.num_states(); }
+  const ArmDescription& description() const { return desc_; }
+
+  /// Progress callback (see ArmSimulationOptions::progress); must outlive the system.
+  void set_progress(const std::function<void(double)>* f) { progress_ = f && *f ? f : nullptr; }
+  void set_jacobian_method(JacobianMethod m) { method_ = m; }
+  JacobianMethod jacobian_method() const { return method_; }
+
+  /// Called by integrate() before each segment between breakpoints: a zero-order-hold input
+  /// gives at the segment's end the value held before the jump there (see cvode.hpp).
+  void set_segment(std::size_t, double, double t_end) { segment_end_ = t_end; }
 
   /// Recorded pressures at time t.
   const Eigen::VectorXd& pressures(double t) {
     if (mode_ == ArmSimulationOptions::PressureInterpolation::pchip)
       pchip_.value(t, p_);
     else
-      input_.value(t, p_, cursor_);
+      input_.value(t, p_, cursor_, t >= segment_end_ ? Side::left : Side::right);
     return p_;
   }
 
   bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> xdot) {
+    if (progress_ && (++rhs_calls_ & 63u) == 0) (*progress_)(t);
     pressures(t);
     f_.rhs(x, p_, xdot);
     return xdot.allFinite();
@@ -106,21 +208,82 @@ class ArmSystem {
   bool jacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
                 const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J) {
     pressures(t);
+    if (method_ == JacobianMethod::forward_dynamics) return jacobian_forward(x, J);
+    return jacobian_inverse(x, J);
+  }
+
+ private:
+  // Seeds x_ad_ with the value x and unit derivatives for states [start, start + kBlock).
+  void seed(const Eigen::Ref<const Eigen::VectorXd>& x, int start) {
+    const int n = size();
+    for (int i = 0; i < n; ++i) {
+      x_ad_(i).value() = x(i);
+      x_ad_(i).derivatives().setZero();
+      if (i >= start && i < start + kBlock) x_ad_(i).derivatives()(i - start) = 1.0;
+    }
+  }
+
+  bool jacobian_forward(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J) {
     const int n = size();
     for (int start = 0; start < n; start += kBlock) {
-      for (int i = 0; i < n; ++i) {
-        x_ad_(i).value() = x(i);
-        x_ad_(i).derivatives().setZero();
-        if (i >= start && i < start + kBlock) x_ad_(i).derivatives()(i - start) = 1.0;
-      }
+      seed(x, start);
       f_ad_.rhs(x_ad_, p_, xd_ad_);
       for (int i = 0; i < n; ++i)
-        for (int k = 0; k < kBlock && start + k < n; ++k) J(i, start + k) = xd_ad_(i).derivatives()(k);
+        for (int k = 0; k < kBlock && start + k < n; ++k)
+          J(i, start + k) = xd_ad_(i).derivatives()(k);
     }
     return J.allFinite();
   }
 
- private:
+  bool jacobian_inverse(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J) {
+    const ArmDescription& d = desc_;
+    const int nq = d.nq, n = size(), nz = d.num_effect_states;
+    // Double evaluation: the acceleration qddot* and M's Cholesky factor at x.
+    f_.rhs(x, p_, xdot_);
+    if (!xdot_.allFinite()) return false;
+    const Eigen::MatrixXd& L = f_.data().mass_factor;  // Cholesky factor in the lower triangle
+    const auto& qdd = f_.data().qddot;
+    for (int i = 0; i < nq; ++i) {
+      a_ad_(i).value() = qdd(i);
+      a_ad_(i).derivatives().setZero();
+    }
+    // d qdot / d qdot = I; d qdot / d (q, z) = 0 (J arrives zeroed from CVODE; not from tests).
+    J.topRows(nq).setZero();
+    J.block(0, nq, nq, nq).setIdentity();
+    for (int start = 0; start < n; start += kBlock) {
+      const int cols = std::min(kBlock, n - start);
+      seed(x, start);
+      q_ad_ = x_ad_.head(nq);
+      v_ad_ = x_ad_.segment(nq, nq);
+      for (int i = 0; i < d.num_inputs; ++i) p_ad_(i) = AD(p_(i));
+      for (std::size_t k = 0; k < d.effects.size(); ++k) {
+        const auto xs =
+            x_ad_.segment(2 * nq + d.effect_state_offsets[k], nz - d.effect_state_offsets[k]);
+        std::visit([&](const auto& e) { e.template effective_pressures<AD>(d.joints, xs, p_ad_); },
+                   d.effects[k]);
+      }
+      const auto& tau = f_ad_.joint_forces(q_ad_, v_ad_, p_ad_);
+      const auto& id = rnea(f_ad_.chain(), f_ad_.data(), q_ad_, v_ad_, a_ad_);
+      for (int i = 0; i < nq; ++i)
+        for (int k = 0; k < kBlock; ++k)
+          dr_(i, k) = tau(i).derivatives()(k) - id(i).derivatives()(k);
+      L.triangularView<Eigen::Lower>().solveInPlace(dr_);
+      L.transpose().triangularView<Eigen::Upper>().solveInPlace(dr_);
+      J.block(nq, start, nq, cols) = dr_.leftCols(cols);
+      // Effect states: differentiate their own derivative.
+      for (std::size_t k = 0; k < d.effects.size(); ++k) {
+        const int off = d.effect_state_offsets[k];
+        const auto xs = x_ad_.segment(2 * nq + off, nz - off);
+        auto xds = xd_ad_.segment(2 * nq + off, nz - off);
+        std::visit([&](const auto& e) { e.template state_derivative<AD>(d.joints, xs, p_, xds); },
+                   d.effects[k]);
+      }
+      for (int i = 2 * nq; i < n; ++i)
+        for (int k = 0; k < cols; ++k) J(i, start + k) = xd_ad_(i).derivatives()(k);
+    }
+    return J.allFinite();
+  }
+
   const ArmDescription& desc_;
   ArmDynamics<double> f_;
   ArmDynamics<AD> f_ad_;
@@ -129,25 +292,90 @@ class ArmSystem {
   PchipSignal pchip_;
   SignalCursor cursor_;
   Eigen::VectorXd p_;
-  Eigen::Matrix<AD, Eigen::Dynamic, 1> x_ad_, xd_ad_;
+  ADVector x_ad_, xd_ad_, q_ad_, v_ad_, a_ad_, p_ad_;
+  Eigen::VectorXd xdot_;
+  Eigen::Matrix<double, Eigen::Dynamic, kBlock> dr_;
+  JacobianMethod method_ = JacobianMethod::inverse_dynamics;
+  double segment_end_ = std::numeric_limits<double>::infinity();
+  const std::function<void(double)>* progress_ = nullptr;
+  unsigned rhs_calls_ = 0;
 };
+
+namespace detail {
+
+/// \brief A System in scaled variables y = x ./ s (s > 0): a scalar absolute tolerance on y
+/// is a tolerance atol * s_i on x_i (CvodeOptions has one atol for all states).
+template <class System>
+class ScaledSystem {
+ public:
+  ScaledSystem(System& sys, Eigen::VectorXd scale)
+      : sys_(sys), s_(std::move(scale)), x_(s_.size()), f_(s_.size()), J_(s_.size(), s_.size()) {}
+
+  int size() const { return static_cast<int>(s_.size()); }
+  void set_segment(std::size_t k, double t_begin, double t_end) {
+    sys_.set_segment(k, t_begin, t_end);
+  }
+
+  bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
+    x_ = s_.cwiseProduct(y);
+    const bool ok = sys_.rhs(t, x_, f_);
+    ydot = f_.cwiseQuotient(s_);
+    return ok;
+  }
+
+  bool jacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+                const Eigen::Ref<const Eigen::VectorXd>& fy, Eigen::Ref<Eigen::MatrixXd> Jy) {
+    x_ = s_.cwiseProduct(y);
+    f_ = s_.cwiseProduct(fy);
+    J_.setZero();
+    const bool ok = sys_.jacobian(t, x_, f_, J_);
+    // dy_i'/dy_j = J_ij s_j / s_i
+    Jy = s_.cwiseInverse().asDiagonal() * J_ * s_.asDiagonal();
+    return ok;
+  }
+
+ private:
+  System& sys_;
+  Eigen::VectorXd s_, x_, f_;
+  Eigen::MatrixXd J_;
+};
+
+}  // namespace detail
 
 /// \brief Simulates the arm on the time grid t with the recorded pressures (N x num_inputs),
 /// from rest at the measured configuration q0 (size nq; zero if empty).
 inline ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::VectorXd& t,
                                   const Eigen::MatrixXd& pressures, const Eigen::VectorXd& q0,
                                   const ArmSimulationOptions& opt = {}) {
+  using PI = ArmSimulationOptions::PressureInterpolation;
   ArmSimulation out;
-  ArmSystem sys(desc, t, pressures, opt.interpolation);
-  const Eigen::VectorXd x0 = initial_state(desc, q0, pressures.row(0).transpose());
+  const bool smoothing = opt.pressure_smoothing > 0;
+  const Eigen::MatrixXd smoothed =
+      smoothing ? smooth_pressures(t, pressures, opt.pressure_smoothing) : Eigen::MatrixXd();
+  const Eigen::MatrixXd& p = smoothing ? smoothed : pressures;
+
+  ArmSystem sys(desc, t, p, opt.interpolation);
+  sys.set_progress(&opt.progress);
+  sys.set_jacobian_method(opt.jacobian_method);
+  const Eigen::VectorXd x0 = initial_state(desc, q0, p.row(0).transpose());
   CvodeOptions copt = opt.cvode;
   copt.use_analytic_jacobian = opt.autodiff_jacobian;
-  using PI = ArmSimulationOptions::PressureInterpolation;
-  const std::vector<double> bp =
-      opt.interpolation == PI::zero_order_hold
-          ? InputSignal(t, pressures, Interpolation::zero_order_hold).breakpoints()
-          : pressure_jumps(t, pressures);
-  out.result = integrate(sys, x0, t, bp, copt);
+  std::vector<double> bp;
+  if (opt.interpolation == PI::zero_order_hold)
+    bp = InputSignal(t, p, Interpolation::zero_order_hold).breakpoints();
+  else if (!smoothing)
+    bp = pressure_jumps(t, p);
+
+  const double vf = opt.velocity_atol_factor;
+  if (vf > 0 && vf != 1.0 && std::isfinite(vf)) {
+    Eigen::VectorXd scale = Eigen::VectorXd::Ones(desc.num_states());
+    scale.segment(desc.nq, desc.nq).setConstant(vf);
+    detail::ScaledSystem<ArmSystem> scaled(sys, scale);
+    out.result = integrate(scaled, x0.cwiseQuotient(scale), t, bp, copt);
+    out.result.x = out.result.x * scale.asDiagonal();
+  } else {
+    out.result = integrate(sys, x0, t, bp, copt);
+  }
   out.states = out.result.x;
   const Eigen::Index rows = out.states.rows();
   out.angles = out.states.leftCols(desc.nq);
