@@ -122,11 +122,7 @@ inline std::vector<ParamSlot> make_slots(const ArmDescription& d, const ArmFitOp
     }
   }
   if (o.effects) {
-    double total_mass = 0;
-    for (const auto& s : d.spec.segments)
-      std::visit([&](const auto& x) {
-        if constexpr (!std::is_same_v<std::decay_t<decltype(x)>, io::RevoluteJointSpec>) total_mass += x.mass;
-      }, s);
+    const double total_mass = d.segment_mass();
     for (std::size_t e = 0; e < d.effects.size(); ++e) {
       const auto names = effect_param_names(d.effects[e], d.joints, d.coordinate_names);
       const EffectBounds b = effect_bounds(d.effects[e], total_mass);

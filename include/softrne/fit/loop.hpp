@@ -324,12 +324,7 @@ inline LoopResult run_loop(const ArmDescription& declared, const io::Dataset& tr
       if (base_cv.empty()) base_cv = cv_errors(current);
       ArmDescription with = current;
       AnyEffect e = detail::make_candidate(s.name, current);
-      double total_mass = 0;
-      for (const auto& seg : current.spec.segments)
-        std::visit([&](const auto& x) {
-          if constexpr (!std::is_same_v<std::decay_t<decltype(x)>, io::RevoluteJointSpec>) total_mass += x.mass;
-        }, seg);
-      const EffectBounds b = effect_bounds(e, total_mass);
+      const EffectBounds b = effect_bounds(e, current.segment_mass());
       Eigen::VectorXd init = s.estimate;
       for (Eigen::Index k = 0; k < init.size(); ++k) {
         double v = std::isfinite(init(k)) ? init(k) : 0.0;

@@ -4,6 +4,7 @@
 /// maps (paper eq. 23), and the effects a fit added; built from a robot description.
 
 #include <stdexcept>
+#include <type_traits>
 #include <string>
 #include <utility>
 #include <variant>
@@ -49,6 +50,16 @@ struct ArmDescription {
     for (const auto& e : effects)
       std::visit([&](const auto& x) { x.measurement_offset(joints, y); }, e);
     return y;
+  }
+
+  /// Mass of the segments of the spec (kg), without effects.
+  double segment_mass() const {
+    double m = 0;
+    for (const auto& seg : spec.segments)
+      std::visit([&](const auto& x) {
+        if constexpr (!std::is_same_v<std::decay_t<decltype(x)>, io::RevoluteJointSpec>) m += x.mass;
+      }, seg);
+    return m;
   }
 
   double tip_mass() const {
