@@ -15,6 +15,10 @@ namespace softrne {
 template <class ChainT, class Q, class Qd>
 void compute_kinematics(const ChainT& chain, typename ChainT::Data& data,
                         const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot) {
+  // The Data first: mass_matrix and gravity pass the Data's own zero velocity as qdot, so a
+  // Data of another chain would otherwise show up as a wrong-size qdot.
+  SOFTRNE_ASSERT(data.tau.size() == chain.num_coordinates(),
+                 "this Data was made for another chain (call chain.make_data())");
   SOFTRNE_ASSERT(q.size() == chain.num_coordinates() && qdot.size() == chain.num_coordinates(),
                  "compute_kinematics: q and qdot must have num_coordinates() entries");
   chain.forward(data, [&](const auto& seg, auto& kin, int, int offset) {
