@@ -83,6 +83,11 @@ class DynamicChain {
     std::visit(
         [&](const auto& seg) {
           using Kin = typename std::decay_t<decltype(seg)>::Kinematics;
+          // Same number of segments and coordinates but other types (a Data made for a
+          // chain built in another order): a message here rather than bad_variant_access.
+          SOFTRNE_ASSERT(std::holds_alternative<Kin>(data.kinematics[k]),
+                         "DynamicChain: this Data was made for another chain (segment types "
+                         "differ; call make_data())");
           f(seg, std::get<Kin>(data.kinematics[k]), i, offsets_[k]);
         },
         segments_[k]);
