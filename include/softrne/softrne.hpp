@@ -14,3 +14,5 @@
 #include "softrne/algorithms/bias.hpp"
 #include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/algorithms/forward_dynamics.hpp"
+#include "softrne/algorithms/own_inertia.hpp"
+#include "softrne/algorithms/articulated_body.hpp"

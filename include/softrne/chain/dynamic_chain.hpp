@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/chain/articulated_workspace.hpp"
 #include "softrne/chain/motion.hpp"
 #include "softrne/config.hpp"
 #include "softrne/segments/segment_list.hpp"
@@ -118,6 +119,9 @@ struct DynamicChainData {
   VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit, qddot;
   MatrixQ mass_matrix;
   MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
+  /// Per-segment scratch of aba (articulated_body.hpp), one per segment.
+  static constexpr int max_segment_nq = detail::variant_max_nq<AnySegment<Scalar>>::value;
+  std::vector<ArticulatedSegment<Scalar, max_segment_nq>> articulated;
 
   DynamicChainData() = default;
   explicit DynamicChainData(const DynamicChain<Scalar>& chain) {
@@ -133,6 +137,7 @@ struct DynamicChainData {
     motion.resize(n + 1);
     loads.resize(n);
     wrench.resize(n + 1);
+    articulated.resize(n);
     tau = VectorQ::Zero(nq);
     gravity_forces = VectorQ::Zero(nq);
     bias_forces = VectorQ::Zero(nq);

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/chain/articulated_workspace.hpp"
 #include "softrne/chain/motion.hpp"
 #include "softrne/segments/segment_concept.hpp"
 
@@ -111,6 +112,8 @@ struct ChainData<Chain<Segments...>> {
   typename ChainT::VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit, qddot;
   typename ChainT::MatrixQ mass_matrix;
   typename ChainT::MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
+  /// Per-segment scratch of aba (articulated_body.hpp).
+  std::array<ArticulatedSegment<Scalar, detail::max_segment_nq<Segments...>()>, N> articulated;
 
   ChainData() = default;
   explicit ChainData(const ChainT&) {
