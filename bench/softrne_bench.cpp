@@ -12,7 +12,7 @@
 //   sim/arm-a-1/{train,test}[/atol1e-08]   CVODE simulation (softrne::sim::simulate_arm) of
 //                                          examples/data/arm-a-1/<split>.csv, default options
 //                                          [or absolute tolerance 1e-8]
-// with <algo> in rnea, gravity, bias, mass_matrix, forward_dynamics and <fn> in rnea,
+// with <algo> in rnea, gravity, bias, mass_matrix, forward_dynamics, aba and <fn> in rnea,
 // gravity (computeGeneralizedGravity), bias (nonLinearEffects), crba, aba.
 //
 // Every call goes through a non-inlined wrapper (as Pinocchio's benchmark/timings.cpp does)
@@ -235,6 +235,12 @@ SOFTRNE_BENCH_NOINLINE const typename ChainT::VectorQ& call_forward_dynamics(
     const typename ChainT::VectorQ& qd, const typename ChainT::VectorQ& tau) {
   return forward_dynamics(c, d, q, qd, tau);
 }
+template <class ChainT>
+SOFTRNE_BENCH_NOINLINE const typename ChainT::VectorQ& call_aba(
+    const ChainT& c, typename ChainT::Data& d, const typename ChainT::VectorQ& q,
+    const typename ChainT::VectorQ& qd, const typename ChainT::VectorQ& tau) {
+  return aba(c, d, q, qd, tau);
+}
 
 enum Algo : unsigned {
   kRnea = 1,
@@ -242,7 +248,8 @@ enum Algo : unsigned {
   kBias = 4,
   kMassMatrix = 8,
   kForwardDynamics = 16,
-  kAll = 31
+  kAba = 32,  // O(n) forward dynamics (articulated_body.hpp)
+  kAll = 63
 };
 
 benchmark::TimeUnit unit_for(double expected_ns) {
@@ -295,6 +302,10 @@ void register_chain(const std::string& prefix, const std::string& suffix,
     reg("forward_dynamics", 0.4 * nq + 1e-3 * nq * nq, [](Fix& x, unsigned k) {
       benchmark::DoNotOptimize(
           call_forward_dynamics(x.chain, x.data, x.q[k], x.qd[k], x.tau[k]).data());
+    });
+  if (which & kAba)
+    reg("aba", 2.5, [](Fix& x, unsigned k) {
+      benchmark::DoNotOptimize(call_aba(x.chain, x.data, x.q[k], x.qd[k], x.tau[k]).data());
     });
 }
 
@@ -560,16 +571,25 @@ class SummaryReporter : public benchmark::ConsoleReporter {
     std::printf("\n=== summary (CPU-time medians of this run; ratio = left / right) ===\n");
     ratio("CC calc / revolute calc (target <= 3)", "calc/cc", "calc/revolute");
     ratio("CC calc / rigid link calc", "calc/cc", "calc/rigid_link");
-    for (const char* a : {"rnea", "gravity", "bias", "mass_matrix", "forward_dynamics"})
+    for (const char* a : {"rnea", "gravity", "bias", "mass_matrix", "forward_dynamics", "aba"})
       ratio(std::string("arm: dynamic / static ") + a, std::string("arm/dynamic/") + a,
             std::string("arm/static/") + a);
+    // Dense (M + Cholesky) against the O(n) articulated-body forward dynamics.
+    for (const std::string m : {"arm/static", "arm/dynamic", "rev6/static", "rev6/dynamic",
+                                "rev30/dynamic"})
+      ratio(m + ": forward_dynamics / aba", m + "/forward_dynamics", m + "/aba");
+    for (int n : {1, 3, 10, 30, 100, 300})
+      ratio("cc/dynamic/" + std::to_string(n) + ": forward_dynamics / aba",
+            "cc/dynamic/forward_dynamics/" + std::to_string(n),
+            "cc/dynamic/aba/" + std::to_string(n));
     for (const char* model : {"rev6", "rev30"}) {
       const std::string m = model;
       const std::pair<const char*, const char*> pairs[] = {{"rnea", "rnea"},
                                                            {"gravity", "gravity"},
                                                            {"bias", "bias"},
                                                            {"mass_matrix", "crba"},
-                                                           {"forward_dynamics", "aba"}};
+                                                           {"forward_dynamics", "aba"},
+                                                           {"aba", "aba"}};
       for (const char* impl : {"static", "dynamic"})
         for (const auto& [ours, theirs] : pairs)
           for (const char* pin_impl : {"pinocchio", "pinocchio_unaligned"})
@@ -577,7 +597,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
                   m + "/" + impl + "/" + ours, m + "/" + pin_impl + "/" + theirs);
     }
     // Scaling of the runtime CC chain: time per CC segment (each with its rigid link).
-    for (const char* a : {"rnea", "mass_matrix"}) {
+    for (const char* a : {"rnea", "mass_matrix", "aba"}) {
       double ref = 0;
       bool any = false;
       for (int n : {1, 3, 10, 30, 100, 300, 1000}) {
@@ -600,7 +620,8 @@ class SummaryReporter : public benchmark::ConsoleReporter {
           hi = std::max(hi, it->second.first / n);
         }
         std::printf("  %s per segment, n = 10..1000: max / min = %.3f%s\n", a, hi / lo,
-                    std::string(a) == "rnea" ? " (target <= 1.25)" : " (O(n nq): grows ~ n)");
+                    std::string(a) == "mass_matrix" ? " (O(n nq): grows ~ n)"
+                                                    : " (target <= 1.25)");
       }
     }
     // Simulations: wall-clock time against the simulated duration (the paper's measure).
@@ -645,6 +666,7 @@ int register_all() {
   for (int n : {1, 3, 10, 30, 100, 300, 1000}) {
     unsigned which = kRnea | kGravity | kBias | kMassMatrix;
     if (n <= 300) which |= kForwardDynamics;  // the O(nq^3) Cholesky dominates beyond
+    which |= kAba;                            // O(n): every n
     register_chain("cc/dynamic", "/" + std::to_string(n),
                    std::make_shared<ChainFixture<DynamicChain<double>>>(make_cc_chain(n), n), which,
                    130.0 * n);
