@@ -42,8 +42,23 @@ struct RevoluteJoint {
     using std::cos;
     using std::sin;
     const Scalar c = cos(q(0)), s = sin(q(0));
-    const Matrix3 K = skew(axis);
-    kin.R_base_distal = Matrix3::Identity() + s * K + (Scalar(1) - c) * K * K;
+    // Rodrigues, R = I + s K + (1 - c) K^2 with K = [a]x, K^2 = a a^T - |a|^2 I, written per
+    // component (no 3x3 product; same formula, so a non-unit axis gives what it gave before).
+    const Scalar x = axis(0), y = axis(1), z = axis(2);
+    const Scalar t = Scalar(1) - c;
+    const Scalar txy = t * x * y, txz = t * x * z, tyz = t * y * z;
+    const Scalar sx = s * x, sy = s * y, sz = s * z;
+    Matrix3& R = kin.R_base_distal;
+    R(0, 0) = Scalar(1) - t * (y * y + z * z);
+    R(1, 0) = txy + sz;
+    R(2, 0) = txz - sy;
+    R(0, 1) = txy - sz;
+    R(1, 1) = Scalar(1) - t * (x * x + z * z);
+    R(2, 1) = tyz + sx;
+    R(0, 2) = txz + sy;
+    R(1, 2) = tyz - sx;
+    R(2, 2) = Scalar(1) - t * (x * x + y * y);
+    // Constant Jacobian (J_v = 0: the origin does not move); its rate is zero.
     kin.J_distal.template topRows<3>().setZero();
     kin.J_distal.template bottomRows<3>() = axis;
   }
