@@ -45,6 +45,9 @@ void add_shift(Eigen::Matrix<Scalar, 3, 3>& A, const Eigen::Matrix<Scalar, 3, 1>
     }
 }
 
+/// Placeholder for the own sub-bodies of a segment without any.
+struct NoSubBodies {};
+
 /// \brief M on the kinematics already in data (any qdot; only q matters).
 ///
 /// \f$M = \sum_b J_b^T \mathcal I_b J_b\f$ over the bodies, evaluated as the composite-body
@@ -61,9 +64,10 @@ void add_shift(Eigen::Matrix<Scalar, 3, 3>& A, const Eigen::Matrix<Scalar, 3, 1>
 ///   distal wrench, where \f$M_{jk} = J_{distal,j}^T w_k\f$ for its coordinates j.
 /// The segment kinematics (trigonometry, Jacobians, inertia) are computed once and shared by
 /// all columns. Cost O(n nq) like nq RNE passes (what this replaced), with a much smaller
-/// constant: per segment and pending column two 3x3 rotations, one cross product and the
-/// projection. Each entry is computed once and written to both triangles, so M is exactly
-/// symmetric.
+/// constant: per segment and pending column one cross product (segments that translate) or
+/// the projection (segments with coordinates); beyond a few pending wrenches they are no
+/// longer rotated (see "lazy" below). Each entry is computed once and written to both
+/// triangles, so M is exactly symmetric.
 ///
 /// Workspace: the pending wrenches live in data.mass_factor (nq >= 6; a small local buffer
 /// otherwise), so mass_matrix() overwrites the Cholesky factor a previous forward_dynamics()
@@ -79,6 +83,13 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
   Scalar* buffer = nq >= 6 ? data.mass_factor.data() : small_buffer.data();
   Eigen::Map<Eigen::Matrix<Scalar, 6, Eigen::Dynamic>> P(buffer, 6, nq);  // pending wrenches
   int first_pending = nq;  // pending columns: [first_pending, nq)
+  // While few wrenches are pending, a turning segment rotates each into its base orientation.
+  // Beyond that they keep one orientation ("lazy"): G maps it to the current frame's
+  // (v_cur = G v_pending) and each segment brings its Jacobian, offset and new wrenches into
+  // it instead: O(1) per segment rather than two 3x3 rotations per segment and pending column.
+  constexpr int kRotateDirectly = 4;  // pending wrenches rotated one by one, at most
+  Matrix3 G = Matrix3::Identity();
+  bool lazy = false;
 
   // Composite beyond the current frame: mass, first moment, inertia about the frame origin,
   // in the distal frame of the segment being visited (after it: in its base frame).
@@ -94,18 +105,30 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
 
     constexpr bool turns = !has_identity_rotation<Segment>::value;
     constexpr bool shifts = !has_zero_translation<Segment>::value;
-    // Pending wrenches into the base frame's orientation, still about the distal origin.
+    // Own mass as one lumped body, or as rigid sub-bodies (distributed CC joint; their
+    // composite, wrenches for qddot = e_k and joint-space inertia come from sub_body_inertia).
+    constexpr bool lumped = Segment::has_body && num_sub_bodies<Segment> == 0;
+    constexpr bool sub_bodies = num_sub_bodies<Segment> > 0;
+    std::conditional_t<sub_bodies, SubBodyInertia<Scalar, (n > 0 ? n : 1)>, NoSubBodies> own;
+    if constexpr (sub_bodies) sub_body_inertia(kin, own);
+    // Pending wrenches (about the distal origin): their orientation into the base frame's.
     if constexpr (turns) {
-      for (int c = first_pending; c < nq; ++c) {
-        const Vector3 f = R * P.col(c).template head<3>();
-        const Vector3 t = R * P.col(c).template tail<3>();
-        P.col(c).template head<3>() = f;
-        P.col(c).template tail<3>() = t;
+      if (lazy) {
+        G = R * G;
+      } else if (nq - first_pending > kRotateDirectly) {
+        G = R;
+        lazy = true;
+      } else {
+        for (int c = first_pending; c < nq; ++c) {
+          const Vector3 f = P.col(c).template head<3>(), t = P.col(c).template tail<3>();
+          P.col(c).template head<3>() = R * f;
+          P.col(c).template tail<3>() = R * t;
+        }
       }
     }
     // The composite in the base orientation (about the distal origin), plus the own body's
     // inertia about its centre of mass: both turn with alpha alike.
-    if constexpr (Segment::has_body) c_I += kin.inertia_com;
+    if constexpr (lumped) c_I += kin.inertia_com;
     Vector3 h;
     Matrix3 I_rot;
     if constexpr (turns) {
@@ -119,13 +142,25 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
     if constexpr (n > 0) {
       const auto Jv = kin.J_distal.template topRows<3>();
       const auto Jw = kin.J_distal.template bottomRows<3>();
-      // Rows of this segment against the coordinates beyond it.
-      // (A segment whose distal origin never moves, shifts == false, has J_v = 0.)
-      for (int c = first_pending; c < nq; ++c) {
-        Eigen::Matrix<Scalar, n, 1> m = Jw.transpose() * P.col(c).template tail<3>();
-        if constexpr (shifts) m.noalias() += Jv.transpose() * P.col(c).template head<3>();
-        M.template block<n, 1>(offset, c) = m;
-        M.template block<1, n>(c, offset) = m.transpose();
+      // Rows of this segment against the coordinates beyond it, with its Jacobian in the
+      // pending wrenches' orientation. (A segment whose distal origin never moves, shifts ==
+      // false, has J_v = 0.)
+      auto project = [&](const auto& Jw_p, const auto& Jv_p) {
+        for (int c = first_pending; c < nq; ++c) {
+          Eigen::Matrix<Scalar, n, 1> m = Jw_p.transpose() * P.col(c).template tail<3>();
+          if constexpr (shifts) m.noalias() += Jv_p.transpose() * P.col(c).template head<3>();
+          M.template block<n, 1>(offset, c) = m;
+          M.template block<1, n>(c, offset) = m.transpose();
+        }
+      };
+      if (lazy) {
+        using Matrix3n = Eigen::Matrix<Scalar, 3, n>;
+        const Matrix3n Jw_p = G.transpose() * Jw;
+        Matrix3n Jv_p;
+        if constexpr (shifts) Jv_p.noalias() = G.transpose() * Jv;
+        project(Jw_p, Jv_p);
+      } else {
+        project(Jw, Jv);
       }
       // Its own columns: the reaction of the composite (rigid with the distal frame) and of
       // the own body (centre of mass along J_com) to qddot = e_k.
@@ -140,21 +175,36 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
           t += h.cross(a);
         }
         Vector3 f_b = Vector3::Zero();
-        if constexpr (Segment::has_body) f_b = seg.mass * kin.J_com.col(k);
+        if constexpr (lumped) f_b = seg.mass * kin.J_com.col(k);
         for (int j = 0; j <= k; ++j) {
           Scalar m_jk = Jw.col(j).dot(t);
           if constexpr (shifts) m_jk += Jv.col(j).dot(f_s);
-          if constexpr (Segment::has_body) m_jk += kin.J_com.col(j).dot(f_b);
+          if constexpr (lumped) m_jk += kin.J_com.col(j).dot(f_b);
+          if constexpr (sub_bodies) m_jk += own.joint(j, k);
           M(offset + j, offset + k) = m_jk;
           M(offset + k, offset + j) = m_jk;
         }
         // Its wrench about the distal origin, base orientation (the own body's force acts at
         // its centre of mass).
         P.col(offset + k).template head<3>() = f_s + f_b;
-        if constexpr (Segment::has_body)
+        if constexpr (lumped)
           P.col(offset + k).template tail<3>() = t + (kin.r_base_com - r_e).cross(f_b);
         else
           P.col(offset + k).template tail<3>() = t;
+        if constexpr (sub_bodies) {  // own wrench about the base origin -> distal origin
+          P.col(offset + k).template head<3>() += own.force.col(k);
+          P.col(offset + k).template tail<3>() +=
+              own.torque.col(k) - r_e.cross(Vector3(own.force.col(k)));
+        }
+      }
+      // The new wrenches (base orientation) into the pending ones' orientation.
+      if (lazy) {
+        for (int k = 0; k < n; ++k) {
+          const Vector3 f = P.col(offset + k).template head<3>();
+          const Vector3 t = P.col(offset + k).template tail<3>();
+          P.col(offset + k).template head<3>() = G.transpose() * f;
+          P.col(offset + k).template tail<3>() = G.transpose() * t;
+        }
       }
       first_pending = offset;
     }
@@ -163,18 +213,26 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
     c_I = I_rot;
     c_h = h;
     if constexpr (shifts) {
-      for (int c = first_pending; c < nq; ++c) {
-        const Vector3 f = P.col(c).template head<3>();
-        P.col(c).template tail<3>() += r_e.cross(f);
+      if (first_pending < nq) {
+        // r_e in the pending wrenches' orientation
+        const Vector3 r_p = lazy ? Vector3(G.transpose() * r_e) : r_e;
+        for (int c = first_pending; c < nq; ++c) {
+          const Vector3 f = P.col(c).template head<3>();
+          P.col(c).template tail<3>() += r_p.cross(f);
+        }
       }
       add_shift(c_I, r_e, Vector3(h + Scalar(0.5) * c_mass * r_e));
       c_h += c_mass * r_e;
     }
-    if constexpr (Segment::has_body) {
+    if constexpr (lumped) {
       const Vector3& r_c = kin.r_base_com;
       add_shift(c_I, r_c, Vector3(Scalar(0.5) * seg.mass * r_c));
       c_h += seg.mass * r_c;
       c_mass += seg.mass;
+    } else if constexpr (sub_bodies) {
+      c_I += own.inertia_origin;
+      c_h += own.first_moment;
+      c_mass += own.mass;
     }
   });
 }

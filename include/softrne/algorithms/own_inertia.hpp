@@ -18,10 +18,8 @@
 /// - joint = \f$\sum_b S_b^T \mathcal I_b S_b = m J_{com}^T J_{com} + J_w^T I J_w\f$, the
 ///   body's share of M (what backward_step's power-conjugate projection gives).
 ///
-/// Segments with several sub-bodies (a distributed-inertia CC segment) overload
-/// `detail::own_body_inertia` for their type (one_body_inertia below is one body), declared in
-/// their own header so that it is visible (through segment_list.hpp) before the definitions of
-/// algorithms/articulated_body.hpp; the generic function refuses kinematics with sub-bodies.
+/// Segments whose own mass is several rigid sub-bodies (the quadrature disks of a
+/// distributed-inertia CC segment, segments/sub_bodies.hpp) sum the same blocks over them.
 
 #include <type_traits>
 #include <utility>
@@ -30,6 +28,7 @@
 
 #include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/algorithms/rnea_steps.hpp"
+#include "softrne/segments/sub_bodies.hpp"
 #include "softrne/spatial/skew.hpp"
 
 namespace softrne {
@@ -38,20 +37,17 @@ namespace softrne {
 /// (linear; angular); see the file comment.
 template <class Scalar, int NQ>
 struct OwnBodyInertia {
-  Eigen::Matrix<Scalar, 6, 6> spatial;   // own bodies' rigid spatial inertia about the base origin, base axes, (linear; angular): wrench (f; n_O) = spatial * (a_O; alpha) for motion rigid with the base frame
-  Eigen::Matrix<Scalar, 6, NQ> coupling; // column k: wrench about the base origin the own bodies need for qddot = e_k with the base at rest
-  Eigen::Matrix<Scalar, NQ, NQ> joint;   // their joint-space inertia  sum_b S_b^T I_b S_b
+  /// Rigid spatial inertia of the own bodies: wrench (f; n_O) = spatial (a_O; alpha) for
+  /// motion rigid with the base frame.
+  Eigen::Matrix<Scalar, 6, 6> spatial;
+  /// Column k: the wrench the own bodies need for qddot = e_k with the base at rest.
+  Eigen::Matrix<Scalar, 6, NQ> coupling;
+  /// Their joint-space inertia \f$\sum_b S_b^T \mathcal I_b S_b\f$ (their share of M).
+  Eigen::Matrix<Scalar, NQ, NQ> joint;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
 namespace detail {
-
-/// Kinematics records that list rigid sub-bodies (`sub_bodies`).
-template <class Kin, class = void>
-struct has_sub_bodies : std::false_type {};
-template <class Kin>
-struct has_sub_bodies<Kin, std::void_t<decltype(std::declval<const Kin&>().sub_bodies)>>
-    : std::true_type {};
 
 /// \brief One rigid body (mass m, centre c, inertia I_c about it in base axes, centre velocity
 /// Jacobian Jv and angular Jacobian Jw relative to the base frame) into out.
@@ -90,10 +86,11 @@ void one_body_inertia(const Scalar& m, const Eigen::Matrix<Scalar, 3, 1>& c,
   }
 }
 
-/// \brief The lumped own body of a segment with `has_body` (CC joint, rigid link): mass
+/// \brief The own body of a segment with `has_body`. Lumped (CC joint, rigid link): mass
 /// seg.mass at kin.r_base_com, inertia \f$R I_c R^T\f$ about it (I_c = kin.inertia_com in
 /// distal axes, eq. 19), centre of mass moving with J_com (not with the distal frame: eq. 9)
-/// and turning with the angular rows of J_distal.
+/// and turning with the angular rows of J_distal. Made of sub-bodies (distributed CC joint):
+/// the sum over them (sub_body_inertia), each with its own Jacobians.
 template <class Segment>
 void own_body_inertia(const Segment& seg, const typename Segment::Kinematics& kin,
                       OwnBodyInertia<typename Segment::Scalar, Segment::nq>& out) {
@@ -101,18 +98,28 @@ void own_body_inertia(const Segment& seg, const typename Segment::Kinematics& ki
   using Scalar = typename Segment::Scalar;
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
   constexpr int n = Segment::nq;
-  // The lumped fields of a kinematics record with sub-bodies are not its inertia: such a
-  // segment must bring its own overload (declared before articulated_body.hpp's definitions).
-  static_assert(!has_sub_bodies<typename Segment::Kinematics>::value,
-                "own_body_inertia: a segment made of sub-bodies needs its own overload");
-  // Inertia about the centre of mass in base axes (eq. 18 turns I_c alpha_distal by R).
-  Matrix3 I_c;
-  if constexpr (has_identity_rotation<Segment>::value)
-    I_c = kin.inertia_com;
-  else
-    I_c = rotate_symmetric(kin.R_base_distal, kin.inertia_com);
-  one_body_inertia<Scalar, n>(seg.mass, kin.r_base_com, I_c, kin.J_com,
-                              kin.J_distal.template bottomRows<3>(), out);
+  if constexpr (num_sub_bodies<Segment> > 0) {
+    (void)seg;
+    SubBodyInertia<Scalar, n> b;
+    sub_body_inertia(kin, b);
+    const Matrix3 H = skew(b.first_moment);
+    out.spatial.template topLeftCorner<3, 3>() = b.mass * Matrix3::Identity();
+    out.spatial.template topRightCorner<3, 3>() = -H;
+    out.spatial.template bottomLeftCorner<3, 3>() = H;
+    out.spatial.template bottomRightCorner<3, 3>() = b.inertia_origin;
+    out.coupling.template topRows<3>() = b.force;
+    out.coupling.template bottomRows<3>() = b.torque;
+    out.joint = b.joint;
+  } else {
+    // Inertia about the centre of mass in base axes (eq. 18 turns I_c alpha_distal by R).
+    Matrix3 I_c;
+    if constexpr (has_identity_rotation<Segment>::value)
+      I_c = kin.inertia_com;
+    else
+      I_c = rotate_symmetric(kin.R_base_distal, kin.inertia_com);
+    one_body_inertia<Scalar, n>(seg.mass, kin.r_base_com, I_c, kin.J_com,
+                                kin.J_distal.template bottomRows<3>(), out);
+  }
 }
 
 }  // namespace detail

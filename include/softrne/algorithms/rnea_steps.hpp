@@ -11,6 +11,7 @@
 #include "softrne/chain/motion.hpp"
 #include "softrne/segments/revolute_joint.hpp"
 #include "softrne/segments/rigid_link.hpp"
+#include "softrne/segments/sub_bodies.hpp"
 
 namespace softrne {
 namespace detail {
@@ -86,7 +87,7 @@ void forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
     distal.acc = acc_e;
   }
 
-  if constexpr (Segment::has_body) {
+  if constexpr (Segment::has_body && num_sub_bodies<Segment> == 0) {
     const Vector3& r_c = kin.r_base_com;
     // Eq. 14 with the centre of mass's own relative velocity and acceleration
     // (the paper writes a_{e,rel} there; it must be a_{c,rel}).
@@ -111,6 +112,42 @@ void forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
     else
       load.torque = torque;
     load.omega_distal = velocity_terms ? distal.omega : Vector3::Zero();
+  } else if constexpr (num_sub_bodies<Segment> > 0) {
+    // Own mass as rigid sub-bodies (the quadrature disks of a distributed CC joint), each with
+    // its own Jacobians relative to the base frame: eqs. 11-12 and 14 for its angular and
+    // linear acceleration, eqs. 16 and 18 for its d'Alembert load (constant inertia in its own
+    // frame: no inertia-rate terms). The load is summed about the base origin; its projection
+    // on the segment's coordinates (backward_step's power-conjugate projection, with each
+    // sub-body's own Jacobians) needs nothing from the children, so it is formed here.
+    static_assert(nq > 0 && nq <= 3, "sub-body segments need 1 to 3 coordinates");
+    Vector3 F = Vector3::Zero(), N = Vector3::Zero();
+    Eigen::Matrix<Scalar, nq, 1> tau_b = Eigen::Matrix<Scalar, nq, 1>::Zero();
+    for (const auto& b : kin.sub_bodies) {
+      const Vector3& r = b.r_base_body;
+      Vector3 alpha_b = dw + b.J_w * qddot;
+      Vector3 acc_b = base.acc + dw.cross(r) + b.J_v * qddot;
+      Vector3 torque_b;
+      if (velocity_terms) {
+        const Vector3 w_rel_b = b.J_w * qdot;
+        const Vector3 v_rel_b = b.J_v * qdot;
+        const Vector3 omega_b = w + w_rel_b;
+        alpha_b += b.Jdot_qdot_w + w.cross(w_rel_b);
+        acc_b += w.cross(w.cross(r)) + Scalar(2) * w.cross(v_rel_b) + b.Jdot_qdot_v;
+        torque_b = b.inertia * alpha_b + omega_b.cross(b.inertia * omega_b);
+      } else {
+        torque_b = b.inertia * alpha_b;
+      }
+      const Vector3 f = b.mass * acc_b;
+      F += f;
+      N += torque_b + r.cross(f);
+      tau_b.noalias() += b.J_v.transpose() * f;
+      tau_b.noalias() += b.J_w.transpose() * torque_b;
+    }
+    load.force = F;
+    load.torque = N;  // about the base origin
+    load.omega_distal.setZero();
+    load.tau_sub_bodies.setZero();
+    load.tau_sub_bodies.template head<nq>() = tau_b;
   }
 }
 
@@ -143,7 +180,9 @@ void backward_step(const Segment&, const typename Segment::Kinematics& kin,
       tau.noalias() = kin.J_distal.template topRows<3>().transpose() * F;
       tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * N;
     }
-    if constexpr (Segment::has_body) {
+    if constexpr (num_sub_bodies<Segment> > 0) {
+      tau += load.tau_sub_bodies.template head<nq>();
+    } else if constexpr (Segment::has_body) {
       tau.noalias() += kin.J_com.transpose() * load.force;
       tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * load.torque;
       if (inertia_rate == InertiaRate::Consistent) {
@@ -160,7 +199,10 @@ void backward_step(const Segment&, const typename Segment::Kinematics& kin,
     base.torque = N;
   else
     base.torque = N + kin.r_base_distal.cross(F);
-  if constexpr (Segment::has_body) {
+  if constexpr (num_sub_bodies<Segment> > 0) {
+    base.force += load.force;
+    base.torque += load.torque;  // already about the base origin
+  } else if constexpr (Segment::has_body) {
     base.force += load.force;
     base.torque += load.torque + kin.r_base_com.cross(load.force);
   }

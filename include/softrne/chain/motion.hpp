@@ -34,6 +34,10 @@ struct BodyLoad {
   Vector3 force = Vector3::Zero();
   Vector3 torque = Vector3::Zero();
   Vector3 omega_distal = Vector3::Zero();
+  /// Segments made of sub-bodies only (distributed-inertia CC joint): `torque` is about the
+  /// base origin instead, and the first nq entries here are the sub-bodies' loads projected
+  /// on the segment's coordinates with their own Jacobians (omega_distal is unused).
+  Vector3 tau_sub_bodies = Vector3::Zero();
 };
 
 /// \brief How the rate of change of a CC segment's configuration-dependent inertia enters.

@@ -143,6 +143,21 @@ struct CCFunctions {
     }
   }
 
+  /// \brief At any argument y: the series below the switch, the closed form at or above it
+  /// (one square root, sine and cosine), everything with second derivatives.
+  void compute(const Scalar& y) {
+    if (y < Scalar(kCCSeriesSwitch)) {
+      compute_series(y);
+      return;
+    }
+    using std::cos;
+    using std::sin;
+    using std::sqrt;
+    const Scalar phi = sqrt(y);
+    const Scalar inv_y = Scalar(1) / y;
+    compute_closed(phi, inv_y, phi * inv_y, sin(phi), cos(phi));
+  }
+
  private:
   using Real = typename Eigen::NumTraits<Scalar>::Real;
 };

@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
+#include <type_traits>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -11,9 +13,80 @@
 #include "softrne/config.hpp"
 #include "softrne/segments/cc_functions.hpp"
 #include "softrne/segments/segment_kinematics.hpp"
+#include "softrne/segments/sub_bodies.hpp"
 #include "softrne/spatial/skew.hpp"
 
 namespace softrne {
+
+/// \brief Inertia model of a CC joint: the paper's one lumped body (eqs. 9, 14, 18-19). The
+/// default.
+struct LumpedInertia {
+  static constexpr int num_points = 0;
+};
+
+/// \brief Default number of Gauss-Legendre points of DistributedInertia: the smallest with
+/// relative error below 1e-8 in M, C qdot and G against the continuum for bending angles up to
+/// 2 rad (tests/core/test_distributed_inertia.cpp, docs/model.md).
+inline constexpr int kDefaultGaussPoints = 6;
+
+/// \brief Inertia model of a CC joint: the exact continuum of thin disks, integrated along the
+/// arc with an NG-point Gauss-Legendre rule. Disk g at arc fraction s_g has the CC pose of
+/// \f$(s_g u, s_g v)\f$ with height \f$s_g h\f$, mass \f$w_g m\f$ and the eq. 20 inertia;
+/// the algorithms treat the disks as rigid sub-bodies of the segment.
+template <int NG = kDefaultGaussPoints>
+struct DistributedInertia {
+  static_assert(NG >= 1, "DistributedInertia needs at least one point");
+  static constexpr int num_points = NG;
+};
+
+namespace detail {
+
+/// \brief NG-point Gauss-Legendre rule on [0, 1] (weights sum to 1), in long double.
+template <int NG>
+struct GaussLegendre01 {
+  std::array<long double, static_cast<std::size_t>(NG)> nodes{}, weights{};
+  GaussLegendre01() {
+    const long double pi = 3.141592653589793238462643383279502884L;
+    for (int i = 0; i < NG; ++i) {
+      // Newton on P_NG from the usual asymptotic guess; nodes in decreasing order of x.
+      long double x = std::cos(pi * (static_cast<long double>(i) + 0.75L) /
+                               (static_cast<long double>(NG) + 0.5L));
+      long double dp = 1;
+      for (int it = 0; it < 100; ++it) {
+        long double p0 = 1, p1 = x;
+        for (int k = 2; k <= NG; ++k) {
+          const long double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
+          p0 = p1;
+          p1 = p2;
+        }
+        if (NG == 1) p0 = 1;
+        dp = NG * (x * p1 - p0) / (x * x - 1);
+        const long double dx = p1 / dp;
+        x -= dx;
+        if (std::fabs(dx) < 1e-19L) break;
+      }
+      {  // derivative at the converged node, for the weight
+        long double p0 = 1, p1 = x;
+        for (int k = 2; k <= NG; ++k) {
+          const long double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
+          p0 = p1;
+          p1 = p2;
+        }
+        if (NG == 1) p0 = 1;
+        dp = NG * (x * p1 - p0) / (x * x - 1);
+      }
+      const auto k = static_cast<std::size_t>(NG - 1 - i);  // increasing s
+      nodes[k] = (1 + x) / 2;
+      weights[k] = 1 / ((1 - x * x) * dp * dp);  // 2 / ((1 - x^2) P'^2), halved for [0, 1]
+    }
+  }
+  static const GaussLegendre01& get() {
+    static const GaussLegendre01 rule;
+    return rule;
+  }
+};
+
+}  // namespace detail
 
 /// \brief A constant-curvature joint with coordinates q = (u, v): the rotation of the distal
 /// end about the base x and y axes, with its mass spread uniformly along the arc of length h
@@ -31,15 +104,26 @@ namespace softrne {
 /// the distal Jacobian shifted to r_c. The model uses \f$\partial r_c/\partial q\f$ because it is
 /// the one that makes the Newton-Euler forces equal the Euler-Lagrange equations of the
 /// lumped energy (tested against a Lagrangian derivation).
-template <class Scalar_>
+///
+/// \tparam InertiaModel LumpedInertia (the paper's model, the default) or
+/// DistributedInertia<NG> (the continuum of thin disks by NG-point Gauss-Legendre quadrature:
+/// each disk rotates with its own part of the arc; the RNE treats the disks as sub-bodies).
+/// Kinematics of the distal frame are the same for both.
+template <class Scalar_, class InertiaModel = LumpedInertia>
 struct ConstantCurvatureJoint {
   using Scalar = Scalar_;
+  using Inertia = InertiaModel;
   static constexpr int nq = 2;
   static constexpr bool has_body = true;
   static constexpr int max_chambers = 8;
-  using Kinematics = SegmentKinematics<Scalar, nq>;
+  /// Quadrature disks (0: lumped).
+  static constexpr int num_points = InertiaModel::num_points;
+  static constexpr bool distributed = num_points > 0;
+  using Kinematics = std::conditional_t<distributed, MultiBodyKinematics<Scalar, nq, num_points>,
+                                        SegmentKinematics<Scalar, nq>>;
   using Vector2 = Eigen::Matrix<Scalar, 2, 1>;
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using Vector6 = Eigen::Matrix<Scalar, 6, 1>;
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
   /// 2 x K map from chamber pressures to (tau_u, tau_v); at most max_chambers columns, stored
   /// inline (no heap).
@@ -79,17 +163,73 @@ struct ConstantCurvatureJoint {
             Kinematics& kin) const {
     const Scalar u = q(0), v = q(1);
     const Scalar ud = qdot(0), vd = qdot(1);
+    if constexpr (distributed) {
+      detail::CCFunctions<Scalar> f;
+      f.compute(u * u + v * v);
+      Vector3 unused_r;
+      Eigen::Matrix<Scalar, 3, nq> unused_J;
+      arc_kinematics<false>(f, u, v, ud, vd, height, kin.R_base_distal, kin.r_base_distal,
+                            kin.J_distal, kin.Jdot_qdot_distal, unused_r, unused_J, unused_r);
+      calc_disks(u, v, ud, vd, kin);
+    } else {
+      const Scalar x = u * u + v * v;  // phi^2
+      detail::CCArcFunctions<Scalar> f;
+      f.compute(x);
+      arc_kinematics<true>(f.at_x, u, v, ud, vd, height, kin.R_base_distal, kin.r_base_distal,
+                           kin.J_distal, kin.Jdot_qdot_distal, kin.r_base_com, kin.J_com,
+                           kin.Jdot_qdot_com);
+      calc_inertia(f, u, v, ud, vd, kin);
+    }
+  }
+
+  /// \brief Generalised forces of the chamber pressures (eq. 24 or a custom layout).
+  template <class P>
+  Vector2 actuation(const Eigen::MatrixBase<P>& pressures) const {
+    return pressure_to_torque * pressures;
+  }
+
+  template <class NewScalar>
+  ConstantCurvatureJoint<NewScalar, InertiaModel> cast() const {
+    ConstantCurvatureJoint<NewScalar, InertiaModel> c;
+    c.mass = NewScalar(mass);
+    c.height = NewScalar(height);
+    c.diameter = NewScalar(diameter);
+    c.stiffness = stiffness.template cast<NewScalar>();
+    c.damping = damping.template cast<NewScalar>();
+    c.pressure_to_torque = pressure_to_torque.template cast<NewScalar>();
+    return c;
+  }
+
+  /// \brief The same joint (parameters) with another inertia model.
+  template <class NewModel>
+  ConstantCurvatureJoint<Scalar, NewModel> with_inertia() const {
+    ConstantCurvatureJoint<Scalar, NewModel> c;
+    c.mass = mass;
+    c.height = height;
+    c.diameter = diameter;
+    c.stiffness = stiffness;
+    c.damping = damping;
+    c.pressure_to_torque = pressure_to_torque;
+    return c;
+  }
+
+  /// \brief Pose, Jacobians and their rates of the distal frame of an arc of height h at
+  /// (u, v) with velocity (ud, vd), from the functions f at \f$u^2+v^2\f$; with kWithCom also
+  /// the centre of mass of the arc (eq. 9). Used for the segment and for each quadrature disk.
+  template <bool kWithCom, class JE, class JC>
+  static void arc_kinematics(const detail::CCFunctions<Scalar>& f, const Scalar& u,
+                             const Scalar& v, const Scalar& ud, const Scalar& vd,
+                             const Scalar& height, Matrix3& R, Vector3& r_e, JE& J_e,
+                             Vector6& Jdot_qdot_e, Vector3& r_c, JC& J_c,
+                             Vector3& Jdot_qdot_c) {
     const Scalar uu = u * u, vv = v * v, uv = u * v;
     const Scalar x = uu + vv;  // phi^2
-    detail::CCArcFunctions<Scalar> f;
-    f.compute(x);
-    const auto& g = f.at_x.g;
-    const auto& dg = f.at_x.dg;
-    const auto& ddg = f.at_x.ddg;
+    const auto& g = f.g;
+    const auto& dg = f.dg;
+    const auto& ddg = f.ddg;
 
     // Eq. 2 is Rodrigues' formula for the rotation vector w = (u, v, 0):
     // R = I + g1 [w]x + g2 [w]x^2 with [w]x^2 = w w^T - x I.
-    Matrix3& R = kin.R_base_distal;
     R(0, 0) = Scalar(1) - g[2] * vv;
     R(0, 1) = g[2] * uv;
     R(0, 2) = g[1] * v;
@@ -123,48 +263,70 @@ struct ConstantCurvatureJoint {
       Jdot_qdot(1) = -A * u - Bs * ud;
       Jdot_qdot(2) = h * (ss4 * ddg[b] + Scalar(2) * dg[b] * wd2);
     };
-    position(2, 1, kin.r_base_distal, kin.J_distal, kin.Jdot_qdot_distal);
-    position(3, 2, kin.r_base_com, kin.J_com, kin.Jdot_qdot_com);
+    position(2, 1, r_e, J_e, Jdot_qdot_e);
+    if constexpr (kWithCom) position(3, 2, r_c, J_c, Jdot_qdot_c);
 
     // Angular velocity omega = J_l(w) wdot with the SO(3) left Jacobian
     // J_l = I + g2 [w]x + g3 [w]x^2 (the angular rows of eq. 6); only its first two columns.
-    kin.J_distal(3, 0) = Scalar(1) - g[3] * vv;
-    kin.J_distal(4, 0) = g[3] * uv;
-    kin.J_distal(5, 0) = -g[2] * v;
-    kin.J_distal(3, 1) = g[3] * uv;
-    kin.J_distal(4, 1) = Scalar(1) - g[3] * uu;
-    kin.J_distal(5, 1) = g[2] * u;
+    J_e(3, 0) = Scalar(1) - g[3] * vv;
+    J_e(4, 0) = g[3] * uv;
+    J_e(5, 0) = -g[2] * v;
+    J_e(3, 1) = g[3] * uv;
+    J_e(4, 1) = Scalar(1) - g[3] * uu;
+    J_e(5, 1) = g[2] * u;
     // Eq. 8 applied to wdot: (dJ_l/dt) wdot = 2s g2' w x wd + 2s g3' w x (w x wd)
     //                                        + g3 wd x (w x wd),
     // with w x wd = c e_z, w x e_z = w_perp, wd x e_z = wd_perp.
     const Scalar c = u * vd - v * ud;
     const Scalar t3 = Scalar(2) * s * dg[3] * c, g3c = g[3] * c;
-    kin.Jdot_qdot_distal(3) = t3 * v + g3c * vd;
-    kin.Jdot_qdot_distal(4) = -t3 * u - g3c * ud;
-    kin.Jdot_qdot_distal(5) = Scalar(2) * s * dg[2] * c;
-
-    calc_inertia(f, u, v, ud, vd, kin);
-  }
-
-  /// \brief Generalised forces of the chamber pressures (eq. 24 or a custom layout).
-  template <class P>
-  Vector2 actuation(const Eigen::MatrixBase<P>& pressures) const {
-    return pressure_to_torque * pressures;
-  }
-
-  template <class NewScalar>
-  ConstantCurvatureJoint<NewScalar> cast() const {
-    ConstantCurvatureJoint<NewScalar> c;
-    c.mass = NewScalar(mass);
-    c.height = NewScalar(height);
-    c.diameter = NewScalar(diameter);
-    c.stiffness = stiffness.template cast<NewScalar>();
-    c.damping = damping.template cast<NewScalar>();
-    c.pressure_to_torque = pressure_to_torque.template cast<NewScalar>();
-    return c;
+    Jdot_qdot_e(3) = t3 * v + g3c * vd;
+    Jdot_qdot_e(4) = -t3 * u - g3c * ud;
+    Jdot_qdot_e(5) = Scalar(2) * s * dg[2] * c;
   }
 
  private:
+  /// \brief The quadrature disks of the distributed model. Disk g at arc fraction s has the
+  /// pose of an arc of height s h at (s u, s v); its position is \f$p(s q; s h)\f$, so its
+  /// Jacobians are s times those of that arc's distal frame, and their rates along qdot are
+  /// that arc's \f$\dot J\dot q\f$ at the velocity s qdot (exact). Mass \f$w_g m\f$, inertia
+  /// about its centre (eq. 20) \f$w_g m D^2/16\,(\mathbf 1 + n n^T)\f$ with n its normal (the
+  /// third column of its rotation): constant in the disk's frame, so no inertia-rate terms.
+  void calc_disks(const Scalar& u, const Scalar& v, const Scalar& ud, const Scalar& vd,
+                  Kinematics& kin) const {
+    using Real = typename Eigen::NumTraits<Scalar>::Real;
+    const auto& rule = detail::GaussLegendre01<num_points>::get();
+    const Scalar a_disk = diameter * diameter / Scalar(16);
+    kin.r_base_com.setZero();
+    kin.J_com.setZero();
+    kin.Jdot_qdot_com.setZero();
+    Eigen::Matrix<Scalar, 6, nq> J;
+    Vector6 Jdq;
+    Vector3 unused_r;
+    Eigen::Matrix<Scalar, 3, nq> unused_J;
+    detail::CCFunctions<Scalar> f;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(num_points); ++k) {
+      const Scalar s(static_cast<Real>(rule.nodes[k]));
+      const Scalar w(static_cast<Real>(rule.weights[k]));
+      const Scalar us = s * u, vs = s * v;
+      f.compute(us * us + vs * vs);
+      auto& b = kin.sub_bodies[k];
+      arc_kinematics<false>(f, us, vs, s * ud, s * vd, s * height, b.R_base_body, b.r_base_body,
+                            J, Jdq, unused_r, unused_J, unused_r);
+      b.mass = w * mass;
+      b.J_v = s * J.template topRows<3>();
+      b.J_w = s * J.template bottomRows<3>();
+      b.Jdot_qdot_v = Jdq.template head<3>();
+      b.Jdot_qdot_w = Jdq.template tail<3>();
+      const Vector3 n = b.R_base_body.col(2);
+      const Scalar a = b.mass * a_disk;
+      b.inertia.noalias() = a * (n * n.transpose());
+      b.inertia.diagonal().array() += a;
+      kin.r_base_com += w * b.r_base_body;
+      kin.J_com += w * b.J_v;
+      kin.Jdot_qdot_com += w * b.Jdot_qdot_v;
+    }
+  }
+
   /// Eqs. 19-22 in closed form. In the base frame, about the centre of mass,
   /// \f$I^b = s_0 \mathbf 1 + a_w w_\perp w_\perp^T + a_{wz}(w_\perp e_z^T + e_z w_\perp^T)
   /// + a_z e_z e_z^T\f$: the disks' own inertia (eq. 20) averaged over the arc, plus the

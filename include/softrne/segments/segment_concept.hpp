@@ -18,19 +18,20 @@ template <class T>
 struct is_segment<T, std::void_t<typename T::Scalar, decltype(T::nq), decltype(T::has_body),
                                  typename T::Kinematics, decltype(std::declval<const T&>().mass),
                                  decltype(std::declval<const T&>().num_inputs())>>
-    : std::bool_constant<std::is_same_v<typename T::Kinematics,
-                                        SegmentKinematics<typename T::Scalar, T::nq>>> {};
+    : std::bool_constant<std::is_base_of_v<SegmentKinematics<typename T::Scalar, T::nq>,
+                                           typename T::Kinematics>> {};
 
 }  // namespace detail
 
 /// \brief Gives one readable error when a type does not model the segment interface:
-/// `Scalar`, `nq`, `has_body`, `Kinematics = SegmentKinematics<Scalar, nq>`, `mass`,
+/// `Scalar`, `nq`, `has_body`, `Kinematics` (SegmentKinematics<Scalar, nq> or derived from
+/// it, e.g. MultiBodyKinematics), `mass`,
 /// `num_inputs()`, `calc(q, qdot, kin)`, `passive_force(q, qdot)`, `cast<S>()`.
 template <class T>
 constexpr void check_segment() {
   static_assert(detail::is_segment<T>::value,
                 "softrne: this type is not a segment: it needs Scalar, nq, has_body, "
-                "Kinematics = SegmentKinematics<Scalar, nq>, mass and num_inputs() "
+                "Kinematics derived from SegmentKinematics<Scalar, nq>, mass and num_inputs() "
                 "(see ConstantCurvatureJoint, RigidLink, RevoluteJoint)");
 }
 

@@ -19,6 +19,9 @@ struct SegmentKinematics {
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   using Vector6 = Eigen::Matrix<Scalar, 6, 1>;
+  /// Rigid sub-bodies the own mass is made of (0: one lumped body described below, if any;
+  /// see MultiBodyKinematics in sub_bodies.hpp).
+  static constexpr int num_sub_bodies = 0;
 
   /// Orientation of the distal frame in the base frame (paper eq. 2, \f$R^{i-1}_i\f$);
   /// the forward pass maps base-frame vectors to the distal frame with its transpose.
