@@ -83,7 +83,13 @@ struct ArmDescription {
         if (cc->pressure_to_torque.cols() > ConstantCurvatureJoint<S>::max_chambers)
           throw std::invalid_argument("joint '" + cc->name + "': more than 8 chambers");
         j.pressure_to_torque = cc->pressure_to_torque.cast<S>();
-        c.add(j, cc->name);
+        if (cc->inertia_model == "distributed") {
+          // The runtime chain has one distributed type, DistributedInertia<> (the default
+          // number of points; build_arm rejects any other quadrature_points).
+          c.add(j.template with_inertia<DistributedInertia<>>(), cc->name);
+        } else {
+          c.add(j, cc->name);
+        }
       } else if (const auto* rl = std::get_if<io::RigidLinkSpec>(&seg)) {
         RigidLink<S> l;
         l.mass = S(rl->mass);
@@ -157,6 +163,14 @@ inline ArmDescription build_arm(const io::RobotSpec& spec) {
     const auto& seg = spec.segments[s];
     if (const auto* cc = std::get_if<io::CCJointSpec>(&seg)) {
       ++cc_index;
+      // "inertia_model": "distributed" runs with DistributedInertia<> (kDefaultGaussPoints).
+      if (cc->inertia_model == "distributed" && cc->quadrature_points != 0 &&
+          cc->quadrature_points != kDefaultGaussPoints)
+        throw std::invalid_argument(
+            (spec.source.empty() ? std::string() : spec.source + ": ") + "segments[" +
+            std::to_string(s) + "] '" + cc->name + "': field 'quadrature_points': the runtime " +
+            "chain supports 0 (default) or " + std::to_string(kDefaultGaussPoints) + " (got " +
+            std::to_string(cc->quadrature_points) + ")");
       ArmJoint j;
       j.name = cc->name;
       j.segment = static_cast<int>(s);
