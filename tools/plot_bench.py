@@ -19,9 +19,10 @@ import sys
 from collections import defaultdict
 
 UNIT_NS = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}
-ALGOS = ["rnea", "gravity", "bias", "mass_matrix", "forward_dynamics"]
+ALGOS = ["rnea", "gravity", "bias", "mass_matrix", "forward_dynamics", "aba"]
+# Pinocchio's counterpart: forward_dynamics (dense) and aba (O(n)) both against its aba.
 PIN_NAME = {"rnea": "rnea", "gravity": "gravity", "bias": "bias", "mass_matrix": "crba",
-            "forward_dynamics": "aba"}
+            "forward_dynamics": "aba", "aba": "aba"}
 
 
 def load(path, which):
@@ -115,7 +116,7 @@ def plot(t, context, path, which):
         m = re.match(r"cc/dynamic/(\w+)/(\d+)$", k)
         if m:
             series[m.group(1)].append((int(m.group(2)), v))
-    markers = dict(zip(ALGOS, "os^dv"))
+    markers = dict(zip(ALGOS, "os^dv*"))
     for a in ALGOS:
         if a not in series:
             continue
@@ -125,10 +126,12 @@ def plot(t, context, path, which):
         ax.loglog(n, y, marker=markers[a], label=f"softrne {a} (CC chain)")
         if a == "rnea":
             ax2.semilogx(n, y * 1e3 / n, marker="o", label="rnea")
-        if a in ("gravity", "bias"):
+        if a in ("gravity", "bias", "aba"):
             ax2.semilogx(n, y * 1e3 / n, marker=markers[a], label=a)
     for impl, style in (("dynamic", "k"), ("pinocchio", "r")):
-        for a, mk in (("rnea", "o"), ("mass_matrix", "d"), ("forward_dynamics", "v")):
+        for a, mk in (("rnea", "o"), ("mass_matrix", "d"), ("forward_dynamics", "v"), ("aba", "*")):
+            if impl == "pinocchio" and a == "aba":
+                continue  # Pinocchio's aba is already drawn against forward_dynamics
             pts = []
             for m in (6, 30):
                 name = f"rev{m}/{impl}/{PIN_NAME[a] if impl == 'pinocchio' else a}"
