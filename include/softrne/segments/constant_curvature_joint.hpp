@@ -45,36 +45,32 @@ namespace detail {
 template <int NG>
 struct GaussLegendre01 {
   std::array<long double, static_cast<std::size_t>(NG)> nodes{}, weights{};
+  /// P_NG(x) and its derivative, by the three-term recurrence.
+  static void legendre(long double x, long double& p, long double& dp) {
+    long double p0 = 1, p1 = x;
+    for (int k = 2; k <= NG; ++k) {
+      const long double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
+      p0 = p1;
+      p1 = p2;
+    }
+    if (NG == 1) p0 = 1;
+    p = p1;
+    dp = NG * (x * p1 - p0) / (x * x - 1);
+  }
   GaussLegendre01() {
     const long double pi = 3.141592653589793238462643383279502884L;
     for (int i = 0; i < NG; ++i) {
       // Newton on P_NG from the usual asymptotic guess; nodes in decreasing order of x.
       long double x = std::cos(pi * (static_cast<long double>(i) + 0.75L) /
                                (static_cast<long double>(NG) + 0.5L));
-      long double dp = 1;
+      long double p = 0, dp = 1;
       for (int it = 0; it < 100; ++it) {
-        long double p0 = 1, p1 = x;
-        for (int k = 2; k <= NG; ++k) {
-          const long double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
-          p0 = p1;
-          p1 = p2;
-        }
-        if (NG == 1) p0 = 1;
-        dp = NG * (x * p1 - p0) / (x * x - 1);
-        const long double dx = p1 / dp;
+        legendre(x, p, dp);
+        const long double dx = p / dp;
         x -= dx;
         if (std::fabs(dx) < 1e-19L) break;
       }
-      {  // derivative at the converged node, for the weight
-        long double p0 = 1, p1 = x;
-        for (int k = 2; k <= NG; ++k) {
-          const long double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
-          p0 = p1;
-          p1 = p2;
-        }
-        if (NG == 1) p0 = 1;
-        dp = NG * (x * p1 - p0) / (x * x - 1);
-      }
+      legendre(x, p, dp);  // derivative at the converged node, for the weight
       const auto k = static_cast<std::size_t>(NG - 1 - i);  // increasing s
       nodes[k] = (1 + x) / 2;
       weights[k] = 1 / ((1 - x * x) * dp * dp);  // 2 / ((1 - x^2) P'^2), halved for [0, 1]
