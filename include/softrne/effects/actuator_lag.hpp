@@ -2,17 +2,25 @@
 /// \file
 /// \brief `actuator_lag`: the torque follows the recorded pressure with a first-order lag.
 
+#include <array>
+
 #include "softrne/effects/effect_base.hpp"
 
 namespace softrne {
 
-/// \brief Each chamber of the listed joints gets a state \f$\bar p\f$ with
+/// \brief Each chamber of the listed joints gets a state \f$\bar p\f$ (Pa) with
 /// \f$\dot{\bar p} = (p - \bar p)/T\f$, and \f$\bar p\f$ replaces p in \f$K_{prs}p\f$ (and in
 /// every other effect). Parameter `T` (s). Models valve/tube dynamics or pressures that are
-/// commanded rather than measured.
-struct ActuatorLag : EffectBase {
+/// commanded rather than measured. T = 0 is singular, so the neutral value is the lower
+/// bound, 1 ms: practically no lag at the arm's bandwidth (a few Hz). The states start at
+/// the first recorded pressures.
+struct ActuatorLag : Effect<ActuatorLag> {
   static constexpr const char* name = "actuator_lag";
-  static constexpr const char* param_name = "T";
+  static constexpr std::array<ParamInfo, 1> param_info{{{"T", 1e-3, 2.0, true, 1e-3, "s"}}};
+  static constexpr std::array<Scope, 3> scopes{Scope::Shared, Scope::PerJoint, Scope::PerChamber};
+  static bool applies_to(const ArmJoint& j) { return j.num_inputs > 0; }
+  static constexpr bool replaces_pressures = true;
+
   int num_states(const std::vector<ArmJoint>& arm) const {
     int n = 0;
     for (int j : joints) n += arm[static_cast<std::size_t>(j)].num_inputs;
@@ -26,17 +34,18 @@ struct ActuatorLag : EffectBase {
       for (int c = 0; c < j.num_inputs; ++c) p(j.input_offset + c) = x(s++);
     }
   }
-  template <class S, class X, class P, class Xd>
-  void state_derivative(const std::vector<ArmJoint>& arm, const X& x, const P& p, Xd& xd) const {
+  template <class S, class X, class Q, class Qd, class P, class Xd>
+  void state_derivative(const std::vector<ArmJoint>& arm, const X& x, const Q&, const Qd&,
+                        const P& p, Xd& xd) const {
     int s = 0;
     for (std::size_t i = 0; i < joints.size(); ++i) {
       const ArmJoint& j = arm[static_cast<std::size_t>(joints[i])];
-      const double inv_T = 1.0 / param(i);
-      for (int c = 0; c < j.num_inputs; ++c, ++s) xd(s) = (p(j.input_offset + c) - x(s)) * S(inv_T);
+      for (int c = 0; c < j.num_inputs; ++c, ++s)
+        xd(s) = (p(j.input_offset + c) - x(s)) * S(1.0 / value(arm, i, 0, c));
     }
   }
-  template <class X, class P>
-  void initial_states(const std::vector<ArmJoint>& arm, const P& p, X& x) const {
+  template <class Q, class P, class X>
+  void initial_states(const std::vector<ArmJoint>& arm, const Q&, const P& p, X& x) const {
     int s = 0;
     for (int jj : joints) {
       const ArmJoint& j = arm[static_cast<std::size_t>(jj)];

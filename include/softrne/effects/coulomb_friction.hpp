@@ -2,6 +2,7 @@
 /// \file
 /// \brief `coulomb_friction`: dry friction opposing the bending rate (smoothed).
 
+#include <array>
 #include <cmath>
 
 #include "softrne/effects/effect_base.hpp"
@@ -11,17 +12,23 @@ namespace softrne {
 /// \brief \f$\tau_k = -F_c \tanh(\dot q_k / v_s)\f$ per coordinate, with the smoothing speed
 /// \f$v_s\f$ = `kSmoothingSpeed` (rad/s): a smooth Coulomb law keeps the ODE Lipschitz for the
 /// implicit integrator. Parameter `Fc` (N m).
-struct CoulombFriction : EffectBase {
+struct CoulombFriction : Effect<CoulombFriction> {
   static constexpr const char* name = "coulomb_friction";
-  static constexpr const char* param_name = "Fc";
+  static constexpr std::array<ParamInfo, 1> param_info{{{"Fc", 0.0, 5.0, false, 0.0, "N m"}}};
+  static constexpr std::array<Scope, 3> scopes{Scope::Shared, Scope::PerJoint,
+                                               Scope::PerCoordinate};
+  static bool applies_to(const ArmJoint&) { return true; }
   static constexpr double kSmoothingSpeed = 0.02;
-  template <class S, class Q, class P, class Tau>
-  void add_forces(const std::vector<ArmJoint>& arm, const Q&, const Q& qd, const P&, Tau& tau) const {
+
+  template <class S, class Q, class Qd, class P, class X, class Tau>
+  void add_forces(const std::vector<ArmJoint>& arm, const Q&, const Qd& qd, const P&, const X&,
+                  Tau& tau) const {
     using std::tanh;
     for (std::size_t i = 0; i < joints.size(); ++i) {
       const ArmJoint& j = arm[static_cast<std::size_t>(joints[i])];
       for (int k = 0; k < j.nq; ++k)
-        tau(j.q_offset + k) -= S(param(i)) * tanh(qd(j.q_offset + k) * S(1.0 / kSmoothingSpeed));
+        tau(j.q_offset + k) -=
+            S(value(arm, i, 0, k)) * tanh(qd(j.q_offset + k) * S(1.0 / kSmoothingSpeed));
     }
   }
 };

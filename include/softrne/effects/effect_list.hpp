@@ -1,8 +1,12 @@
 #pragma once
 /// \file
-/// \brief The one place that lists every effect type.
+/// \brief The one place that lists every effect type, and the functions that enumerate them.
+/// What an effect is (its parameters, scopes, joints) is read from its own header by
+/// effect_info.hpp.
 
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -20,31 +24,36 @@ namespace softrne {
 using AnyEffect = std::variant<Stiffening, PressureStiffening, ActuatorLag, CoulombFriction,
                                QuadraticDamping, ChamberMisalignment, Payload, AngleOffset>;
 
+namespace detail {
+template <class F, std::size_t... I>
+void for_each_effect_type(F&& f, std::index_sequence<I...>) {
+  (f(std::variant_alternative_t<I, AnyEffect>{}), ...);
+}
+}  // namespace detail
+
+/// \brief Calls f(E{}) for every effect type E, in the order of AnyEffect.
+template <class F>
+void for_each_effect_type(F&& f) {
+  detail::for_each_effect_type(f, std::make_index_sequence<std::variant_size_v<AnyEffect>>{});
+}
+
 /// \brief Names of all effects, in the order of AnyEffect.
 inline std::vector<std::string> effect_names() {
-  return {Stiffening::name,      PressureStiffening::name, ActuatorLag::name,
-          CoulombFriction::name, QuadraticDamping::name,   ChamberMisalignment::name,
-          Payload::name,         AngleOffset::name};
+  std::vector<std::string> names;
+  for_each_effect_type([&](auto tag) { names.push_back(decltype(tag)::name); });
+  return names;
 }
 
 /// \brief A default-constructed effect of the given name; false if the name is unknown.
 inline bool make_effect(const std::string& name, AnyEffect& out) {
   bool found = false;
-  auto try_one = [&](auto tag) {
+  for_each_effect_type([&](auto tag) {
     using E = decltype(tag);
     if (!found && name == E::name) {
       out = E{};
       found = true;
     }
-  };
-  try_one(Stiffening{});
-  try_one(PressureStiffening{});
-  try_one(ActuatorLag{});
-  try_one(CoulombFriction{});
-  try_one(QuadraticDamping{});
-  try_one(ChamberMisalignment{});
-  try_one(Payload{});
-  try_one(AngleOffset{});
+  });
   return found;
 }
 
@@ -53,7 +62,7 @@ inline std::string effect_name(const AnyEffect& e) {
   return std::visit([](const auto& x) { return std::string(std::decay_t<decltype(x)>::name); }, e);
 }
 
-/// \brief The common part (joints, shared, params) of the effect held.
+/// \brief The common part (joints, scope, params) of the effect held.
 inline EffectBase& effect_base(AnyEffect& e) {
   return std::visit([](auto& x) -> EffectBase& { return x; }, e);
 }

@@ -21,24 +21,6 @@
 
 namespace softrne::fit {
 
-/// \brief Bounds of an effect parameter (per effect type, never per data set).
-struct EffectBounds {
-  double lower, upper;
-  bool log_scale;
-};
-
-/// \brief Physically plausible ranges of each effect's parameter.
-inline EffectBounds effect_bounds(const AnyEffect& e, double total_mass) {
-  if (std::holds_alternative<Stiffening>(e)) return {-1.0, 20.0, false};            // 1/rad^2
-  if (std::holds_alternative<PressureStiffening>(e)) return {-5.0, 50.0, false};    // 1/MPa
-  if (std::holds_alternative<ActuatorLag>(e)) return {1e-3, 2.0, true};             // s
-  if (std::holds_alternative<CoulombFriction>(e)) return {0.0, 5.0, false};         // N m
-  if (std::holds_alternative<QuadraticDamping>(e)) return {0.0, 50.0, false};       // N m s^2
-  if (std::holds_alternative<ChamberMisalignment>(e)) return {-1.5, 1.5, false};    // rad
-  if (std::holds_alternative<Payload>(e)) return {0.0, 3.0 * total_mass, false};    // kg
-  return {-0.6, 0.6, false};                                                         // rad
-}
-
 /// \brief What to fit.
 struct ArmFitOptions {
   bool stiffness = true;       ///< per-axis K_spring of every joint
@@ -122,12 +104,13 @@ inline std::vector<ParamSlot> make_slots(const ArmDescription& d, const ArmFitOp
     }
   }
   if (o.effects) {
-    const double total_mass = d.segment_mass();
+    // Bounds come from each effect's own description (never from the data set).
+    const double arm_mass = d.segment_mass();
     for (std::size_t e = 0; e < d.effects.size(); ++e) {
-      const auto names = effect_param_names(d.effects[e], d.joints, d.coordinate_names);
-      const EffectBounds b = effect_bounds(d.effects[e], total_mass);
+      const auto names = effect_param_names(d.effects[e], d);
       const auto& params = effect_base(d.effects[e]).params;
       for (std::size_t k = 0; k < names.size(); ++k) {
+        const EffectBounds b = effect_param_bounds(d.effects[e], static_cast<int>(k), arm_mass);
         ps.add({effect_name(d.effects[e]) + "." + names[k], params(static_cast<Eigen::Index>(k)),
                 b.lower, b.upper, b.log_scale});
         slots.push_back({ParamSlot::kEffect, static_cast<int>(e), static_cast<int>(k)});
@@ -200,7 +183,8 @@ inline ArmFitResult fit_arm(const ArmDescription& start, const io::Dataset& data
   auto make_residual = [&]() -> ResidualFn {
     return [&, d = start](const Eigen::VectorXd& x, Eigen::VectorXd& r) mutable {
       detail::apply(slots, x, start, d);
-      // Payload mass changes the chain; everything else is read at evaluation time.
+      // Payload and mass_scale change the chain, which simulate_dataset rebuilds; everything
+      // else is read at evaluation time.
       const sim::ArmSimulation s = simulate_dataset(d, data, opt.simulation);
       ++sims;
       if (!s.ok() || s.angles.rows() != N) return false;

@@ -58,6 +58,8 @@ using SegmentSpec = std::variant<CCJointSpec, RigidLinkSpec, RevoluteJointSpec>;
 struct EffectSpec {
   std::string name;
   std::vector<std::string> joints;  ///< names of segments it applies to
+  /// By name: `<kind>` (shared) or `<kind>.<joint, coordinate or pressure channel>`; the
+  /// names present set the scope (formats.md section 4, read by softrne::build_arm).
   std::map<std::string, double> params;
   std::string evidence;  ///< short human-readable reason
 };

@@ -200,8 +200,16 @@ inline void validate_robot_global(const RobotSpec& robot, const std::string& sou
         throw InputError(Category::UnknownName, source,
                          field_where(where, "joints[" + std::to_string(k) + "]"),
                          "no segment is named " + quoted(eff.joints[k]));
-    for (const auto& [key, value] : eff.params)
+    // Names are '<kind>' (shared) or '<kind>.<joint, coordinate or pressure channel>'
+    // (formats.md section 4); which kinds and names an effect has is checked by build_arm.
+    for (const auto& [key, value] : eff.params) {
+      const std::size_t dot = key.find('.');
+      if (key.empty() || dot == 0 || (dot != std::string::npos && dot + 1 == key.size()))
+        throw InputError(Category::InvalidValue, source, field_where(where, "params." + key),
+                         "a parameter name is '<kind>' or '<kind>.<joint, coordinate or "
+                         "chamber>'");
       NumberCheck{source, field_where(where, "params." + key)}.finite(value);
+    }
   }
 }
 

@@ -3,9 +3,10 @@
 /// \brief A whole arm as the tools use it: the chain, the joints' springs, dampers and pressure
 /// maps (paper eq. 23), and the effects a fit added; built from a robot description.
 
+#include <algorithm>
 #include <stdexcept>
-#include <type_traits>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -14,7 +15,7 @@
 
 #include "softrne/algorithms/forward_dynamics.hpp"
 #include "softrne/chain/dynamic_chain.hpp"
-#include "softrne/effects/effect_list.hpp"
+#include "softrne/effects/effect_info.hpp"
 #include "softrne/io/robot_spec.hpp"
 
 namespace softrne {
@@ -44,12 +45,49 @@ struct ArmDescription {
     return -1;
   }
 
-  /// Offsets added to simulated coordinates to give measured angles (angle_offset).
-  Eigen::VectorXd measurement_offset() const {
-    Eigen::VectorXd y = Eigen::VectorXd::Zero(nq);
+  /// Size of effect k's slice of the effect states.
+  int effect_state_size(std::size_t k) const {
+    const int end = k + 1 < effect_state_offsets.size() ? effect_state_offsets[k + 1]
+                                                         : num_effect_states;
+    return end - effect_state_offsets[k];
+  }
+
+  /// Measurement model: the sensors report y = gain .* q + offset (sensor_gain,
+  /// angle_offset); both nq vectors, gain 1 and offset 0 without effects.
+  void measurement(Eigen::VectorXd& gain, Eigen::VectorXd& offset) const {
+    gain = Eigen::VectorXd::Ones(nq);
+    offset = Eigen::VectorXd::Zero(nq);
     for (const auto& e : effects)
-      std::visit([&](const auto& x) { x.measurement_offset(joints, y); }, e);
-    return y;
+      std::visit([&](const auto& x) { x.measurement(joints, gain, offset); }, e);
+  }
+  Eigen::VectorXd measurement_gain() const {
+    Eigen::VectorXd g, o;
+    measurement(g, o);
+    return g;
+  }
+  Eigen::VectorXd measurement_offset() const {
+    Eigen::VectorXd g, o;
+    measurement(g, o);
+    return o;
+  }
+  /// What the sensors report for simulated coordinates q.
+  Eigen::VectorXd measured(const Eigen::VectorXd& q) const {
+    Eigen::VectorXd g, o;
+    measurement(g, o);
+    return g.cwiseProduct(q) + o;
+  }
+  /// The simulated coordinates that the sensors report as y: (y - offset) ./ gain.
+  Eigen::VectorXd coordinates_from_measured(const Eigen::VectorXd& y) const {
+    Eigen::VectorXd g, o;
+    measurement(g, o);
+    return (y - o).cwiseQuotient(g);
+  }
+
+  /// Transport delay of the recorded pressures (s): the sum of the effects' delays.
+  double input_delay() const {
+    double d = 0;
+    for (const auto& e : effects) d += std::visit([](const auto& x) { return x.input_delay(); }, e);
+    return d;
   }
 
   /// Mass of the segments of the spec (kg), without effects.
@@ -62,20 +100,33 @@ struct ArmDescription {
     return m;
   }
 
+  /// Point mass the effects add at the tip (payload), kg.
   double tip_mass() const {
     double m = 0;
     for (const auto& e : effects) m += std::visit([](const auto& x) { return x.tip_mass(); }, e);
     return m;
   }
 
-  /// \brief The chain (segments of the spec, plus a payload point mass if an effect adds one).
+  /// Factor on each segment's mass and inertia (mass_scale); 1 without effects.
+  std::vector<double> segment_mass_scale() const {
+    std::vector<double> s(spec.segments.size(), 1.0);
+    for (const auto& e : effects) std::visit([&](const auto& x) { x.mass_scale(joints, s); }, e);
+    return s;
+  }
+
+  /// \brief The chain: the segments of the spec with their masses and inertias scaled by any
+  /// mass_scale effect, plus a payload point mass if an effect adds one.
   template <class S>
   DynamicChain<S> make_chain() const {
     DynamicChain<S> c;
-    for (const auto& seg : spec.segments) {
+    const std::vector<double> scale = segment_mass_scale();
+    for (std::size_t s = 0; s < spec.segments.size(); ++s) {
+      const auto& seg = spec.segments[s];
       if (const auto* cc = std::get_if<io::CCJointSpec>(&seg)) {
         ConstantCurvatureJoint<S> j;
-        j.mass = S(cc->mass);
+        // A CC joint's inertia follows from its mass and geometry (eqs. 19-22), so scaling
+        // the mass scales the inertia too.
+        j.mass = S(cc->mass * scale[s]);
         j.height = S(cc->height);
         j.diameter = S(cc->diameter);
         j.stiffness = cc->stiffness.cast<S>();
@@ -92,10 +143,10 @@ struct ArmDescription {
         }
       } else if (const auto* rl = std::get_if<io::RigidLinkSpec>(&seg)) {
         RigidLink<S> l;
-        l.mass = S(rl->mass);
+        l.mass = S(rl->mass * scale[s]);
         l.length = S(rl->length);
         l.com = rl->com.cast<S>();
-        l.inertia = rl->inertia.cast<S>();
+        l.inertia = (rl->inertia * scale[s]).cast<S>();
         c.add(l, rl->name);
       } else if (const auto* rj = std::get_if<io::RevoluteJointSpec>(&seg)) {
         RevoluteJoint<S> r;
@@ -117,40 +168,133 @@ struct ArmDescription {
   }
 };
 
-/// \brief Number of parameters of an effect on these joints.
-inline int effect_num_params(const AnyEffect& e, const std::vector<ArmJoint>& joints) {
-  const EffectBase& b = effect_base(e);
-  if (std::holds_alternative<AngleOffset>(e)) {
-    int n = 0;
-    for (int j : b.joints) n += joints[static_cast<std::size_t>(j)].nq;
-    return n;
-  }
-  if (std::holds_alternative<Payload>(e) || b.shared) return 1;
-  return static_cast<int>(b.joints.size());
+/// \brief Names of an effect's parameters on this arm (effect_param_names with the
+/// description's coordinate and pressure names).
+inline std::vector<std::string> effect_param_names(const AnyEffect& e, const ArmDescription& d) {
+  return effect_param_names(e, d.joints, d.coordinate_names, d.pressure_names);
 }
 
-/// \brief Names of an effect's parameters, in the order of its `params`: `beta` when shared,
-/// `beta.joint2` per joint, `offset.u1`-style per coordinate for angle_offset.
-inline std::vector<std::string> effect_param_names(const AnyEffect& e,
-                                                   const std::vector<ArmJoint>& joints,
-                                                   const std::vector<std::string>& coordinate_names) {
-  const EffectBase& b = effect_base(e);
-  const std::string base =
-      std::visit([](const auto& x) { return std::string(std::decay_t<decltype(x)>::param_name); }, e);
-  std::vector<std::string> names;
-  if (std::holds_alternative<AngleOffset>(e)) {
-    for (int j : b.joints) {
-      const ArmJoint& jt = joints[static_cast<std::size_t>(j)];
-      for (int k = 0; k < jt.nq; ++k)
-        names.push_back(base + "." + coordinate_names[static_cast<std::size_t>(jt.q_offset + k)]);
-    }
-  } else if (std::holds_alternative<Payload>(e) || b.shared) {
-    names.push_back(base);
-  } else {
-    for (int j : b.joints) names.push_back(base + "." + joints[static_cast<std::size_t>(j)].name);
-  }
-  return names;
+/// \brief Appends an effect to the description and gives it its slice of the effect states.
+/// Throws std::invalid_argument if its parameter count does not match its scope and joints.
+inline void add_effect(ArmDescription& d, AnyEffect e) {
+  const int np = effect_num_params(e, d.joints);
+  if (effect_base(e).params.size() != np)
+    throw std::invalid_argument("effect '" + effect_name(e) + "': " +
+                                std::to_string(effect_base(e).params.size()) +
+                                " parameters given, its scope and joints need " +
+                                std::to_string(np));
+  d.effect_state_offsets.push_back(d.num_effect_states);
+  d.num_effect_states += std::visit([&](const auto& x) { return x.num_states(d.joints); }, e);
+  d.effects.push_back(std::move(e));
 }
+
+/// \brief A candidate at its neutral values: effect `name` on `joints` (indices into the
+/// joint table; all joints it applies to when empty) with `scope`. Throws
+/// std::invalid_argument on an unknown name, a scope the effect does not allow, or a joint it
+/// does not apply to.
+inline AnyEffect make_effect_at_neutral(const std::string& name, const ArmDescription& d,
+                                        Scope scope, std::vector<int> joints = {}) {
+  AnyEffect e;
+  if (!make_effect(name, e))
+    throw std::invalid_argument("effect '" + name + "': unknown effect name");
+  if (!effect_scope_allowed(e, scope))
+    throw std::invalid_argument("effect '" + name + "': scope '" + scope_name(scope) +
+                                "' is not allowed");
+  if (joints.empty()) {
+    for (std::size_t j = 0; j < d.joints.size(); ++j)
+      if (effect_applies_to(e, d.joints[j])) joints.push_back(static_cast<int>(j));
+  } else {
+    for (int j : joints)
+      if (j < 0 || j >= static_cast<int>(d.joints.size()) ||
+          !effect_applies_to(e, d.joints[static_cast<std::size_t>(j)]))
+        throw std::invalid_argument("effect '" + name + "': does not apply to joint index " +
+                                    std::to_string(j));
+  }
+  EffectBase& b = effect_base(e);
+  b.joints = std::move(joints);
+  b.scope = scope;
+  const int np = effect_num_params(e, d.joints);
+  b.params.resize(np);
+  for (int k = 0; k < np; ++k) b.params(k) = effect_param_bounds(e, k, d.segment_mass()).neutral;
+  return e;
+}
+
+namespace detail {
+
+/// \brief Reads an effect's parameters from a robot-file entry: the scope is the one whose
+/// names (formats.md section 4) are exactly the keys present. `where` names the entry.
+inline void read_effect_params(const io::EffectSpec& es, const ArmDescription& a,
+                               const std::string& where, AnyEffect& e) {
+  EffectBase& b = effect_base(e);
+  const int nk = effect_num_kinds(e);
+  std::string kinds;
+  for (int k = 0; k < nk; ++k) kinds += std::string(k ? ", " : "") + effect_param_info(e, k).name;
+  if (es.params.empty())
+    throw std::invalid_argument(where + ": field 'params': no parameters (kinds: " + kinds + ")");
+  const std::vector<Scope> scopes = effect_scopes(e);
+  std::vector<std::vector<std::string>> names(scopes.size());
+  for (std::size_t s = 0; s < scopes.size(); ++s) {
+    b.scope = scopes[s];
+    names[s] = effect_param_names(e, a);
+  }
+  auto in = [](const std::vector<std::string>& v, const std::string& x) {
+    return std::find(v.begin(), v.end(), x) != v.end();
+  };
+  // The scope whose names are exactly the keys; else the first that holds them all (and so
+  // misses some).
+  std::size_t pick = scopes.size();
+  for (std::size_t s = 0; s < scopes.size(); ++s) {
+    bool all = true;
+    for (const auto& kv : es.params) all = all && in(names[s], kv.first);
+    if (all && (pick == scopes.size() || names[s].size() == es.params.size())) pick = s;
+    if (all && names[s].size() == es.params.size()) break;
+  }
+  if (pick < scopes.size()) {
+    const std::size_t s = pick;
+    b.scope = scopes[s];
+    b.params.resize(static_cast<Eigen::Index>(names[s].size()));
+    for (std::size_t k = 0; k < names[s].size(); ++k) {
+      const auto it = es.params.find(names[s][k]);
+      if (it == es.params.end())
+        throw std::invalid_argument(where + ": field 'params': missing '" + names[s][k] + "' (" +
+                                    scope_name(scopes[s]) + " scope)");
+      b.params(static_cast<Eigen::Index>(k)) = it->second;
+    }
+    return;
+  }
+  // No scope holds them all: a key that fits none, or a mix.
+  std::string forms;
+  for (Scope sc : scopes)
+    forms += std::string(forms.empty() ? "" : ", ") +
+             (sc == Scope::Shared ? "'<kind>'" : std::string("'<kind>.<") + scope_name(sc) + ">'");
+  std::string first_key;
+  std::size_t first_scope = scopes.size();
+  for (const auto& kv : es.params) {
+    const std::string kind = kv.first.substr(0, kv.first.find('.'));
+    bool known = false;
+    for (int k = 0; k < nk; ++k) known = known || kind == effect_param_info(e, k).name;
+    if (!known)
+      throw std::invalid_argument(where + ": field 'params." + kv.first + "': unknown kind '" +
+                                  kind + "' (kinds: " + kinds + ")");
+    std::size_t s = 0;
+    while (s < scopes.size() && !in(names[s], kv.first)) ++s;
+    if (s == scopes.size())
+      throw std::invalid_argument(where + ": field 'params." + kv.first +
+                                  "': names no listed joint, coordinate or chamber (forms: " +
+                                  forms + ")");
+    if (first_scope == scopes.size()) {
+      first_key = kv.first;
+      first_scope = s;
+    } else if (s != first_scope) {
+      throw std::invalid_argument(where + ": field 'params': mixes scopes: '" + first_key + "' (" +
+                                  scope_name(scopes[first_scope]) + ") and '" + kv.first + "' (" +
+                                  scope_name(scopes[s]) + ")");
+    }
+  }
+  throw std::invalid_argument(where + ": field 'params': inconsistent parameter names");
+}
+
+}  // namespace detail
 
 /// \brief Builds the description from a robot spec; its `effects` become model effects.
 /// Throws std::invalid_argument naming the effect and field on an inconsistent effect.
@@ -205,38 +349,26 @@ inline ArmDescription build_arm(const io::RobotSpec& spec) {
   }
   a.nq = q;
   a.num_inputs = p;
-  for (const auto& es : spec.effects) {
+  for (std::size_t i = 0; i < spec.effects.size(); ++i) {
+    const io::EffectSpec& es = spec.effects[i];
+    const std::string where = (spec.source.empty() ? std::string() : spec.source + ": ") +
+                              "effects[" + std::to_string(i) + "] '" + es.name + "'";
     AnyEffect e;
     if (!make_effect(es.name, e))
-      throw std::invalid_argument("effect '" + es.name + "': unknown effect name");
+      throw std::invalid_argument(where + ": field 'name': unknown effect name");
     EffectBase& b = effect_base(e);
     for (const auto& jn : es.joints) {
       const int ji = a.joint_index(jn);
-      if (ji < 0) throw std::invalid_argument("effect '" + es.name + "': field 'joints': '" + jn + "' is not a joint");
+      if (ji < 0)
+        throw std::invalid_argument(where + ": field 'joints': '" + jn + "' is not a joint");
+      if (!effect_applies_to(e, a.joints[static_cast<std::size_t>(ji)]))
+        throw std::invalid_argument(where + ": field 'joints': the effect does not apply to '" +
+                                    jn + "'");
       b.joints.push_back(ji);
     }
-    // Shared when the file uses the bare parameter name ("beta"), per joint otherwise
-    // ("beta.joint1"); angle_offset is always per coordinate, payload always shared.
-    const std::string bare =
-        std::visit([](const auto& x) { return std::string(std::decay_t<decltype(x)>::param_name); }, e);
-    b.shared = !std::holds_alternative<AngleOffset>(e) &&
-               (std::holds_alternative<Payload>(e) || es.params.count(bare) > 0);
-    const auto names = effect_param_names(e, a.joints, a.coordinate_names);
-    b.params.resize(static_cast<Eigen::Index>(names.size()));
-    for (std::size_t k = 0; k < names.size(); ++k) {
-      const auto it = es.params.find(names[k]);
-      if (it == es.params.end())
-        throw std::invalid_argument("effect '" + es.name + "': field 'params': missing '" + names[k] + "'");
-      b.params(static_cast<Eigen::Index>(k)) = it->second;
-    }
-    a.effects.push_back(e);
+    detail::read_effect_params(es, a, where, e);
+    add_effect(a, std::move(e));
   }
-  int offset = 0;
-  for (const auto& e : a.effects) {
-    a.effect_state_offsets.push_back(offset);
-    offset += std::visit([&](const auto& x) { return x.num_states(a.joints); }, e);
-  }
-  a.num_effect_states = offset;
   return a;
 }
 
@@ -248,7 +380,7 @@ inline std::vector<io::EffectSpec> effect_specs(const ArmDescription& a) {
     s.name = effect_name(e);
     const EffectBase& b = effect_base(e);
     for (int j : b.joints) s.joints.push_back(a.joints[static_cast<std::size_t>(j)].name);
-    const auto names = effect_param_names(e, a.joints, a.coordinate_names);
+    const auto names = effect_param_names(e, a);
     for (std::size_t k = 0; k < names.size(); ++k) s.params[names[k]] = b.params(static_cast<Eigen::Index>(k));
     out.push_back(s);
   }
@@ -276,6 +408,9 @@ inline io::RobotSpec to_robot_spec(const ArmDescription& a) {
 
 /// \brief Evaluates the arm's state equation x' = f(x, p) for one scalar type: eq. 23 with the
 /// effects. Holds its chain and workspace, so evaluation allocates nothing.
+///
+/// Arguments named xs are the effect states (x without q and qdot, size num_effect_states);
+/// each effect sees its own slice of them.
 template <class S>
 class ArmDynamics {
  public:
@@ -292,10 +427,28 @@ class ArmDynamics {
   const DynamicChain<S>& chain() const { return chain_; }
   DynamicChainData<S>& data() { return data_; }
 
+  /// \brief The pressures that drive the joints: the recorded ones changed by the effects.
+  /// Effects that replace them (actuator_lag) act first, then those that transform them
+  /// (chamber_gain), each group in list order; so the result does not depend on the order in
+  /// which a fit added them.
+  template <class X, class P>
+  void effective_pressures(const X& xs, const P& p_recorded, VectorS& p_eff) const {
+    const auto& d = *desc_;
+    for (int i = 0; i < d.num_inputs; ++i) p_eff(i) = S(p_recorded(i));
+    for (int pass = 0; pass < 2; ++pass)
+      for (std::size_t k = 0; k < d.effects.size(); ++k)
+        std::visit(
+            [&](const auto& e) {
+              if (std::decay_t<decltype(e)>::replaces_pressures == (pass == 0))
+                e.template effective_pressures<S>(d.joints, own(xs, k), p_eff);
+            },
+            d.effects[k]);
+  }
+
   /// \brief Generalised forces other than inertia and gravity: \f$K_{prs}p - Kq - K_d\dot q\f$
-  /// plus the effects, at the effective pressures p.
-  template <class Q, class P>
-  const VectorS& joint_forces(const Q& q, const Q& qd, const P& p) {
+  /// plus the effects, at the effective pressures p and effect states xs.
+  template <class Q, class Qd, class P, class X>
+  const VectorS& joint_forces(const Q& q, const Qd& qd, const P& p, const X& xs) {
     const auto& d = *desc_;
     for (const auto& j : d.joints) {
       for (int k = 0; k < j.nq; ++k) {
@@ -305,9 +458,27 @@ class ArmDynamics {
         tau_(j.q_offset + k) = t;
       }
     }
-    for (const auto& e : d.effects)
-      std::visit([&](const auto& x) { x.template add_forces<S>(d.joints, q, qd, p, tau_); }, e);
+    for (std::size_t k = 0; k < d.effects.size(); ++k)
+      std::visit(
+          [&](const auto& e) { e.template add_forces<S>(d.joints, q, qd, p, own(xs, k), tau_); },
+          d.effects[k]);
     return tau_;
+  }
+
+  /// \brief Time derivative of the effect states (size num_effect_states) given the
+  /// recorded pressures.
+  template <class X, class Q, class Qd, class P, class Xd>
+  void effect_state_derivative(const X& xs, const Q& q, const Qd& qd, const P& p_recorded,
+                               Xd&& xsd) const {
+    const auto& d = *desc_;
+    for (std::size_t k = 0; k < d.effects.size(); ++k) {
+      auto xsd_k = xsd.segment(d.effect_state_offsets[k], d.effect_state_size(k));
+      std::visit(
+          [&](const auto& e) {
+            e.template state_derivative<S>(d.joints, own(xs, k), q, qd, p_recorded, xsd_k);
+          },
+          d.effects[k]);
+    }
   }
 
   /// \brief x' = f(x, p_recorded).
@@ -317,42 +488,39 @@ class ArmDynamics {
     const int n = d.nq;
     const auto q = x.head(n);
     const auto qd = x.segment(n, n);
-    for (int i = 0; i < d.num_inputs; ++i) p_eff_(i) = S(p_recorded(i));
-    for (std::size_t k = 0; k < d.effects.size(); ++k) {
-      const auto xs = x.segment(2 * n + d.effect_state_offsets[k], d.num_effect_states - d.effect_state_offsets[k]);
-      std::visit([&](const auto& e) { e.template effective_pressures<S>(d.joints, xs, p_eff_); }, d.effects[k]);
-    }
-    joint_forces(q, qd, p_eff_);
+    const auto xs = x.segment(2 * n, d.num_effect_states);
+    effective_pressures(xs, p_recorded, p_eff_);
+    joint_forces(q, qd, p_eff_, xs);
     forward_dynamics(chain_, data_, q, qd, tau_);
     xdot.head(n) = qd;
     xdot.segment(n, n) = data_.qddot;
-    for (std::size_t k = 0; k < d.effects.size(); ++k) {
-      const int off = d.effect_state_offsets[k];
-      const int len = d.num_effect_states - off;
-      const auto xs = x.segment(2 * n + off, len);
-      auto xds = xdot.segment(2 * n + off, len);
-      std::visit([&](const auto& e) { e.template state_derivative<S>(d.joints, xs, p_recorded, xds); },
-                 d.effects[k]);
-    }
+    effect_state_derivative(xs, q, qd, p_recorded, xdot.segment(2 * n, d.num_effect_states));
   }
 
  private:
+  // Effect k's slice of the effect states.
+  template <class X>
+  auto own(const X& xs, std::size_t k) const {
+    return xs.segment(desc_->effect_state_offsets[k], desc_->effect_state_size(k));
+  }
+
   const ArmDescription* desc_;
   DynamicChain<S> chain_;
   DynamicChainData<S> data_;
   VectorS p_eff_, tau_;
 };
 
-/// \brief Initial state: at rest at the first measured configuration (less angle offsets),
-/// effect states from the first recorded pressures.
+/// \brief Initial state: at rest at the first measured configuration with the measurement
+/// model inverted (q0 = (y0 - offset) ./ gain), effect states from q0 and the first recorded
+/// pressures. An empty y0 means q0 = 0.
 inline Eigen::VectorXd initial_state(const ArmDescription& d, const Eigen::VectorXd& q0_measured,
                                      const Eigen::VectorXd& p0) {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(d.num_states());
-  if (q0_measured.size() == d.nq) x.head(d.nq) = q0_measured - d.measurement_offset();
+  if (q0_measured.size() == d.nq) x.head(d.nq) = d.coordinates_from_measured(q0_measured);
+  const Eigen::VectorXd q0 = x.head(d.nq);
   for (std::size_t k = 0; k < d.effects.size(); ++k) {
-    const int off = d.effect_state_offsets[k];
-    auto xs = x.segment(2 * d.nq + off, d.num_effect_states - off);
-    std::visit([&](const auto& e) { e.initial_states(d.joints, p0, xs); }, d.effects[k]);
+    auto xs = x.segment(2 * d.nq + d.effect_state_offsets[k], d.effect_state_size(k));
+    std::visit([&](const auto& e) { e.initial_states(d.joints, q0, p0, xs); }, d.effects[k]);
   }
   return x;
 }

@@ -68,7 +68,8 @@ struct ArmSimulationOptions {
   }
 };
 
-/// \brief Result: measured-space angles (simulated q plus any angle offset) on the input grid.
+/// \brief Result: measured-space angles (the measurement model applied to the simulated q:
+/// gain .* q + offset) on the input grid.
 struct ArmSimulation {
   Eigen::MatrixXd angles;  ///< N x nq (rows computed before a failure, if any)
   Eigen::MatrixXd states;  ///< N x num_states
@@ -164,7 +165,8 @@ class ArmSystem {
                mode == ArmSimulationOptions::PressureInterpolation::zero_order_hold
                    ? Interpolation::zero_order_hold
                    : Interpolation::linear),
-        pchip_(t, pressures) {
+        pchip_(t, pressures),
+        delay_(desc.input_delay()) {
     const int nq = desc.nq, ns = desc.num_states();
     p_.resize(desc.num_inputs);
     x_ad_.resize(ns);
@@ -189,14 +191,19 @@ class ArmSystem {
   /// gives at the segment's end the value held before the jump there (see cvode.hpp).
   void set_segment(std::size_t, double, double t_end) { segment_end_ = t_end; }
 
-  /// Recorded pressures at time t.
+  /// Recorded pressures that act at time t: read at t - input_delay (input_delay effect),
+  /// clamped to the first sample before it (the signals clamp outside their range).
   const Eigen::VectorXd& pressures(double t) {
+    const double tr = t - delay_;
     if (mode_ == ArmSimulationOptions::PressureInterpolation::pchip)
-      pchip_.value(t, p_);
+      pchip_.value(tr, p_);
     else
-      input_.value(t, p_, cursor_, t >= segment_end_ ? Side::left : Side::right);
+      input_.value(tr, p_, cursor_, t >= segment_end_ ? Side::left : Side::right);
     return p_;
   }
+
+  /// The transport delay the system applies to the recorded pressures (s).
+  double input_delay() const { return delay_; }
 
   bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> xdot) {
     if (progress_ && (++rhs_calls_ & 63u) == 0) (*progress_)(t);
@@ -255,14 +262,9 @@ class ArmSystem {
       seed(x, start);
       q_ad_ = x_ad_.head(nq);
       v_ad_ = x_ad_.segment(nq, nq);
-      for (int i = 0; i < d.num_inputs; ++i) p_ad_(i) = AD(p_(i));
-      for (std::size_t k = 0; k < d.effects.size(); ++k) {
-        const auto xs =
-            x_ad_.segment(2 * nq + d.effect_state_offsets[k], nz - d.effect_state_offsets[k]);
-        std::visit([&](const auto& e) { e.template effective_pressures<AD>(d.joints, xs, p_ad_); },
-                   d.effects[k]);
-      }
-      const auto& tau = f_ad_.joint_forces(q_ad_, v_ad_, p_ad_);
+      const auto xs = x_ad_.segment(2 * nq, nz);
+      f_ad_.effective_pressures(xs, p_, p_ad_);
+      const auto& tau = f_ad_.joint_forces(q_ad_, v_ad_, p_ad_, xs);
       const auto& id = rnea(f_ad_.chain(), f_ad_.data(), q_ad_, v_ad_, a_ad_);
       for (int i = 0; i < nq; ++i)
         for (int k = 0; k < kBlock; ++k)
@@ -270,14 +272,8 @@ class ArmSystem {
       L.triangularView<Eigen::Lower>().solveInPlace(dr_);
       L.transpose().triangularView<Eigen::Upper>().solveInPlace(dr_);
       J.block(nq, start, nq, cols) = dr_.leftCols(cols);
-      // Effect states: differentiate their own derivative.
-      for (std::size_t k = 0; k < d.effects.size(); ++k) {
-        const int off = d.effect_state_offsets[k];
-        const auto xs = x_ad_.segment(2 * nq + off, nz - off);
-        auto xds = xd_ad_.segment(2 * nq + off, nz - off);
-        std::visit([&](const auto& e) { e.template state_derivative<AD>(d.joints, xs, p_, xds); },
-                   d.effects[k]);
-      }
+      // Effect states: differentiate their own derivative (it may depend on q and qdot).
+      f_ad_.effect_state_derivative(xs, q_ad_, v_ad_, p_, xd_ad_.segment(2 * nq, nz));
       for (int i = 2 * nq; i < n; ++i)
         for (int k = 0; k < cols; ++k) J(i, start + k) = xd_ad_(i).derivatives()(k);
     }
@@ -296,6 +292,7 @@ class ArmSystem {
   Eigen::VectorXd xdot_;
   Eigen::Matrix<double, Eigen::Dynamic, kBlock> dr_;
   JacobianMethod method_ = JacobianMethod::inverse_dynamics;
+  double delay_ = 0;
   double segment_end_ = std::numeric_limits<double>::infinity();
   const std::function<void(double)>* progress_ = nullptr;
   unsigned rhs_calls_ = 0;
@@ -365,6 +362,8 @@ inline ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::Vecto
     bp = InputSignal(t, p, Interpolation::zero_order_hold).breakpoints();
   else if (!smoothing)
     bp = pressure_jumps(t, p);
+  // A delayed input jumps later (integrate drops breakpoints past the end).
+  for (double& b : bp) b += sys.input_delay();
 
   const double vf = opt.velocity_atol_factor;
   if (vf > 0 && vf != 1.0 && std::isfinite(vf)) {
@@ -378,8 +377,11 @@ inline ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::Vecto
   }
   out.states = out.result.x;
   const Eigen::Index rows = out.states.rows();
-  out.angles = out.states.leftCols(desc.nq);
-  if (rows > 0) out.angles.rowwise() += desc.measurement_offset().transpose();
+  // What the sensors report: y = gain .* q + offset (sensor_gain, angle_offset).
+  Eigen::VectorXd gain, offset;
+  desc.measurement(gain, offset);
+  out.angles = out.states.leftCols(desc.nq) * gain.asDiagonal();
+  if (rows > 0) out.angles.rowwise() += offset.transpose();
   return out;
 }
 

@@ -1,0 +1,112 @@
+#pragma once
+/// \file
+/// \brief Generic readers of the effects' self-description (each effect's header): allowed
+/// scopes, parameter kinds, names, bounds. Used by the model, the fitter, the closed loop and
+/// the robot-file reader, so none of them lists effect-specific numbers.
+
+#include <algorithm>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "softrne/effects/effect_list.hpp"
+
+namespace softrne {
+
+/// \brief The scopes the effect's parameters may have.
+inline std::vector<Scope> effect_scopes(const AnyEffect& e) {
+  return std::visit(
+      [](const auto& x) {
+        using E = std::decay_t<decltype(x)>;
+        return std::vector<Scope>(E::scopes.begin(), E::scopes.end());
+      },
+      e);
+}
+
+/// \brief Whether `s` is one of the effect's allowed scopes.
+inline bool effect_scope_allowed(const AnyEffect& e, Scope s) {
+  const auto scopes = effect_scopes(e);
+  return std::find(scopes.begin(), scopes.end(), s) != scopes.end();
+}
+
+/// \brief Whether the effect can act on joint j (e.g. pressure effects need chambers).
+inline bool effect_applies_to(const AnyEffect& e, const ArmJoint& j) {
+  return std::visit([&](const auto& x) { return std::decay_t<decltype(x)>::applies_to(j); }, e);
+}
+
+/// \brief Number of parameter kinds per unit (2 for viscoelastic: k and tau).
+inline int effect_num_kinds(const AnyEffect& e) {
+  return std::visit(
+      [](const auto& x) { return static_cast<int>(std::decay_t<decltype(x)>::param_info.size()); },
+      e);
+}
+
+/// \brief Description of parameter kind `kind`.
+inline ParamInfo effect_param_info(const AnyEffect& e, int kind) {
+  return std::visit(
+      [&](const auto& x) {
+        return std::decay_t<decltype(x)>::param_info[static_cast<std::size_t>(kind)];
+      },
+      e);
+}
+
+/// \brief Number of parameters of an effect (by its scope and listed joints).
+inline int effect_num_params(const AnyEffect& e, const std::vector<ArmJoint>& joints) {
+  return effect_base(e).num_units(joints) * effect_num_kinds(e);
+}
+
+/// \brief The suffixes that name the units of `scope` on the listed joints: "" (shared),
+/// ".joint2" (joint name), ".u1" (coordinate name), ".p1_2" (pressure channel name).
+inline std::vector<std::string> effect_unit_suffixes(
+    const std::vector<int>& listed, Scope scope, const std::vector<ArmJoint>& joints,
+    const std::vector<std::string>& coordinate_names,
+    const std::vector<std::string>& pressure_names) {
+  std::vector<std::string> out;
+  if (scope == Scope::Shared) return {""};
+  for (int ji : listed) {
+    const ArmJoint& j = joints[static_cast<std::size_t>(ji)];
+    if (scope == Scope::PerJoint) {
+      out.push_back("." + j.name);
+    } else if (scope == Scope::PerCoordinate) {
+      for (int k = 0; k < j.nq; ++k)
+        out.push_back("." + coordinate_names[static_cast<std::size_t>(j.q_offset + k)]);
+    } else {
+      for (int c = 0; c < j.num_inputs; ++c)
+        out.push_back("." + pressure_names[static_cast<std::size_t>(j.input_offset + c)]);
+    }
+  }
+  return out;
+}
+
+/// \brief Names of an effect's parameters, in the order of its `params` (formats.md section
+/// 4): the kind name plus the unit's suffix, e.g. `beta`, `beta.joint2`, `offset.u1`,
+/// `gain.p1_2`, and for several kinds `k.joint1`, `tau.joint1`, `k.joint2`, ...
+inline std::vector<std::string> effect_param_names(const AnyEffect& e,
+                                                   const std::vector<ArmJoint>& joints,
+                                                   const std::vector<std::string>& coordinate_names,
+                                                   const std::vector<std::string>& pressure_names) {
+  const EffectBase& b = effect_base(e);
+  const int nk = effect_num_kinds(e);
+  std::vector<std::string> names;
+  for (const std::string& suffix :
+       effect_unit_suffixes(b.joints, b.scope, joints, coordinate_names, pressure_names))
+    for (int k = 0; k < nk; ++k) names.push_back(effect_param_info(e, k).name + suffix);
+  return names;
+}
+
+/// \brief Search range, scale and neutral value of one parameter.
+struct EffectBounds {
+  double lower, upper;
+  bool log_scale;
+  double neutral;
+};
+
+/// \brief Bounds of params(param_index), from the effect's ParamInfo; ranges marked
+/// per_arm_mass are multiplied by `arm_mass` (kg, the declared segments' mass).
+inline EffectBounds effect_param_bounds(const AnyEffect& e, int param_index, double arm_mass) {
+  const ParamInfo info = effect_param_info(e, param_index % effect_num_kinds(e));
+  const double f = info.per_arm_mass ? arm_mass : 1.0;
+  return {info.lower * f, info.upper * f, info.log_scale, info.neutral};
+}
+
+}  // namespace softrne
