@@ -18,11 +18,13 @@
 #include "softrne/effects/pressure_stiffening.hpp"
 #include "softrne/effects/quadratic_damping.hpp"
 #include "softrne/effects/stiffening.hpp"
+#include "softrne/effects/viscoelastic.hpp"
 
 namespace softrne {
 
-using AnyEffect = std::variant<Stiffening, PressureStiffening, ActuatorLag, CoulombFriction,
-                               QuadraticDamping, ChamberMisalignment, Payload, AngleOffset>;
+using AnyEffect =
+    std::variant<Stiffening, PressureStiffening, ActuatorLag, CoulombFriction, QuadraticDamping,
+                 ChamberMisalignment, Payload, AngleOffset, Viscoelastic>;
 
 namespace detail {
 template <class F, std::size_t... I>
