@@ -12,6 +12,7 @@
 
 #include "softrne/effects/actuator_lag.hpp"
 #include "softrne/effects/angle_offset.hpp"
+#include "softrne/effects/chamber_gain.hpp"
 #include "softrne/effects/chamber_misalignment.hpp"
 #include "softrne/effects/coulomb_friction.hpp"
 #include "softrne/effects/payload.hpp"
@@ -24,7 +25,7 @@ namespace softrne {
 
 using AnyEffect =
     std::variant<Stiffening, PressureStiffening, ActuatorLag, CoulombFriction, QuadraticDamping,
-                 ChamberMisalignment, Payload, AngleOffset, Viscoelastic>;
+                 ChamberMisalignment, Payload, AngleOffset, Viscoelastic, ChamberGain>;
 
 namespace detail {
 template <class F, std::size_t... I>
