@@ -1,0 +1,25 @@
+#pragma once
+/// \file
+/// \brief `input_delay`: the recorded pressures act later than they are recorded.
+
+#include <array>
+
+#include "softrne/effects/effect_base.hpp"
+
+namespace softrne {
+
+/// \brief A pure transport delay d (s) of every pressure channel: the joints feel
+/// \f$p(t - d)\f$, clamped to the first sample before the record starts (tubes between the
+/// sensor and the chamber, or a logging clock offset). The simulator reads the recorded
+/// pressures at t - ArmDescription::input_delay(). Kind `delay` (s, neutral 0), shared only:
+/// one delay for the whole arm (the listed joints only say which joints have inputs).
+struct InputDelay : Effect<InputDelay> {
+  static constexpr const char* name = "input_delay";
+  static constexpr std::array<ParamInfo, 1> param_info{{{"delay", 0.0, 0.5, false, 0.0, "s"}}};
+  static constexpr std::array<Scope, 1> scopes{Scope::Shared};
+  static bool applies_to(const ArmJoint& j) { return j.num_inputs > 0; }
+
+  double input_delay() const { return params.size() > 0 ? params(0) : 0.0; }
+};
+
+}  // namespace softrne
