@@ -15,6 +15,7 @@
 #include "softrne/effects/chamber_gain.hpp"
 #include "softrne/effects/chamber_misalignment.hpp"
 #include "softrne/effects/coulomb_friction.hpp"
+#include "softrne/effects/hysteresis.hpp"
 #include "softrne/effects/input_delay.hpp"
 #include "softrne/effects/payload.hpp"
 #include "softrne/effects/pressure_stiffening.hpp"
@@ -26,7 +27,8 @@ namespace softrne {
 
 using AnyEffect =
     std::variant<Stiffening, PressureStiffening, ActuatorLag, CoulombFriction, QuadraticDamping,
-                 ChamberMisalignment, Payload, AngleOffset, Viscoelastic, ChamberGain, InputDelay>;
+                 ChamberMisalignment, Payload, AngleOffset, Viscoelastic, ChamberGain, InputDelay,
+                 Hysteresis>;
 
 namespace detail {
 template <class F, std::size_t... I>
