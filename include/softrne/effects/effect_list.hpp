@@ -17,6 +17,7 @@
 #include "softrne/effects/coulomb_friction.hpp"
 #include "softrne/effects/hysteresis.hpp"
 #include "softrne/effects/input_delay.hpp"
+#include "softrne/effects/mass_scale.hpp"
 #include "softrne/effects/payload.hpp"
 #include "softrne/effects/pressure_stiffening.hpp"
 #include "softrne/effects/quadratic_damping.hpp"
@@ -28,7 +29,7 @@ namespace softrne {
 using AnyEffect =
     std::variant<Stiffening, PressureStiffening, ActuatorLag, CoulombFriction, QuadraticDamping,
                  ChamberMisalignment, Payload, AngleOffset, Viscoelastic, ChamberGain, InputDelay,
-                 Hysteresis>;
+                 Hysteresis, MassScale>;
 
 namespace detail {
 template <class F, std::size_t... I>
