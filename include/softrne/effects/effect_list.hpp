@@ -21,6 +21,7 @@
 #include "softrne/effects/payload.hpp"
 #include "softrne/effects/pressure_stiffening.hpp"
 #include "softrne/effects/quadratic_damping.hpp"
+#include "softrne/effects/sensor_gain.hpp"
 #include "softrne/effects/stiffening.hpp"
 #include "softrne/effects/viscoelastic.hpp"
 
@@ -29,7 +30,7 @@ namespace softrne {
 using AnyEffect =
     std::variant<Stiffening, PressureStiffening, ActuatorLag, CoulombFriction, QuadraticDamping,
                  ChamberMisalignment, Payload, AngleOffset, Viscoelastic, ChamberGain, InputDelay,
-                 Hysteresis, MassScale>;
+                 Hysteresis, MassScale, SensorGain>;
 
 namespace detail {
 template <class F, std::size_t... I>
