@@ -1,9 +1,8 @@
 #!/usr/bin/env python3
 """Plots of a closed-loop run (softrne-loop --plots DIR): measured vs simulated angles before
-and after the loop on train and test (like the paper's Figs. 5-6), and the baseline
-equation-error residual against the regressor of the first effect the loop added."""
+and after the loop on train and test (like the paper's Figs. 5-6), and the training
+simulation residual per coordinate before and after."""
 import argparse
-import glob
 import os
 
 import matplotlib
@@ -45,26 +44,22 @@ def angles_figure(measured, baseline, final, title, out):
 
 
 def residual_figure(directory, out):
-    regs = glob.glob(os.path.join(directory, "regressor_*.csv"))
-    if not regs:
+    base = os.path.join(directory, "residual_baseline.csv")
+    final = os.path.join(directory, "residual_final.csv")
+    if not (os.path.exists(base) and os.path.exists(final)):
         return
-    name = os.path.basename(regs[0])[len("regressor_"):-4]
-    hr, r = read(os.path.join(directory, "residual_baseline.csv"))
-    _, x = read(regs[0])
-    _, rf = read(os.path.join(directory, "residual_final.csv"))
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    for k in range(1, r.shape[1]):
-        axes[0].scatter(x[:, k], r[:, k], s=2, alpha=0.4, label=hr[k])
-    axes[0].set_xlabel(f"regressor of {name} (N m per unit parameter)")
-    axes[0].set_ylabel("baseline equation-error residual (N m)")
-    axes[0].legend(fontsize=7, markerscale=4)
-    axes[0].set_title("residual vs the chosen effect's regressor")
-    for k in range(1, r.shape[1]):
-        axes[1].plot(r[:, 0], r[:, k], lw=0.6, alpha=0.5)
-    axes[1].plot(rf[:, 0], np.linalg.norm(rf[:, 1:], axis=1), "k-", lw=1.0, label="|final residual|")
-    axes[1].set_xlabel("t (s)")
-    axes[1].set_title("baseline residual per coordinate, and final norm")
-    axes[1].legend(fontsize=7)
+    hr, r = read(base)
+    _, rf = read(final)
+    n = r.shape[1] - 1
+    fig, axes = plt.subplots(n, 1, figsize=(10, 1.6 * n + 1), sharex=True, squeeze=False)
+    for k in range(n):
+        ax = axes[k][0]
+        ax.plot(r[:, 0], r[:, k + 1], "-", color="tab:gray", lw=0.7, label="baseline")
+        ax.plot(rf[:, 0], rf[:, k + 1], "-", color="tab:green", lw=0.9, label="after the loop")
+        ax.set_ylabel(f"{hr[k + 1]} (rad)")
+        ax.legend(fontsize=7, loc="upper right", ncol=2)
+    axes[-1][0].set_xlabel("t (s)")
+    fig.suptitle("training simulation residual (measured - simulated), before and after the loop")
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)

@@ -15,7 +15,7 @@
 namespace {
 
 // Writes what tools/plot_loop.py draws: simulated angles before and after on both data sets,
-// and the baseline residual against the first added effect's regressor; then runs the script.
+// and the simulation residual (measured - simulated) on train before and after; then runs it.
 void write_plot_data(const std::string& dir, const softrne::fit::LoopResult& r, const softrne::io::Dataset& train,
                      const softrne::io::Dataset& test, const softrne::fit::LoopOptions& opt) {
   using namespace softrne;
@@ -30,16 +30,8 @@ void write_plot_data(const std::string& dir, const softrne::fit::LoopResult& r, 
   sim(r.baseline.fitted, test, "test_baseline.csv");
   sim(r.final_fit.fitted, test, "test_final.csv");
   const auto& names = r.baseline.fitted.coordinate_names;
-  io::write_trajectory_csv(dir + "/residual_baseline.csv", train.t, r.residual, names);
-  io::write_trajectory_csv(dir + "/residual_final.csv", train.t, r.final_residual, names);
-  if (!r.added.empty()) {
-    const auto tr = fit::detail::differentiate(train, opt.smoothing);
-    const AnyEffect cand = fit::detail::make_candidate(effect_name(r.added[0].effect), r.baseline.fitted);
-    const Eigen::MatrixXd Phi = fit::detail::candidate_regressors(r.baseline.fitted, cand, tr);
-    Eigen::MatrixXd reg(train.t.size(), r.baseline.fitted.nq);
-    for (Eigen::Index i = 0; i < reg.rows(); ++i) reg.row(i) = Phi.block(i * reg.cols(), 0, reg.cols(), 1).transpose();
-    io::write_trajectory_csv(dir + "/regressor_" + effect_name(r.added[0].effect) + ".csv", train.t, reg, names);
-  }
+  if (r.baseline_residual.size()) io::write_trajectory_csv(dir + "/residual_baseline.csv", train.t, r.baseline_residual, names);
+  if (r.final_residual.size()) io::write_trajectory_csv(dir + "/residual_final.csv", train.t, r.final_residual, names);
   const std::string script = std::string(SOFTRNE_SOURCE_DIR) + "/tools/plot_loop.py";
   const char* py = std::getenv("SOFTRNE_PYTHON");
   const std::string cmd = std::string(py && *py ? py : "python3") + " '" + script + "' --dir '" + dir + "' --train '" + train.source + "' --test '" +
@@ -55,18 +47,20 @@ int main(int argc, char** argv) {
   using namespace softrne;
   return cli::run("softrne-loop", [&] {
     cli::ArgParser args("softrne-loop", "--robot R.json --train train.csv --test test.csv --out report.json [--plots DIR]",
-                        "Fits the declared model, ranks the candidate effects by how much of the equation-error "
-                        "residual each explains, confirms the best by cross-validation on the training data, "
-                        "adds the ones that earn their place, refits, and reports the error before and after "
+                        "Fits the declared model, screens every effect in every scope by its predicted held-out "
+                        "simulation error, refits the best in cross-validation folds of the training data, adds "
+                        "those that lower the held-out error in every fold, refits, and reports the error before "
+                        "and after, the sensor noise floor and what stays unexplained "
                         "(docs/closing-the-loop.md). The test data only measures.");
     args.option("robot", "R.json", "robot description (softrne-robot/1)").required();
     args.option("train", "train.csv", "training data (pressures and measured angles)").required();
     args.option("test", "test.csv", "test data: measured only, never used to select").required();
-    args.option("out", "report.json", "the report (softrne-loop-report/1)").required();
+    args.option("out", "report.json", "the report (softrne-loop-report/2)").required();
     args.option("plots", "DIR",
                 "also write the data for plots and draw them with tools/plot_loop.py (python3 with numpy and "
                 "matplotlib; another interpreter via the environment variable SOFTRNE_PYTHON)");
     args.option("threads", "N", "parallel simulations (default 2)");
+    args.option("max-effects", "N", "at most this many effects (default 4)");
     args.flag("quiet", "no progress lines");
     if (!args.parse(argc, argv)) return cli::kExitOk;
     const io::RobotSpec spec = io::read_robot_json(args.value("robot"));
@@ -80,6 +74,7 @@ int main(int argc, char** argv) {
     }
     fit::LoopOptions opt;
     opt.fit.optimiser.threads = static_cast<int>(args.number("threads", 2, 1, 64));
+    opt.max_effects = static_cast<int>(args.number("max-effects", 4, 0, 16));
     if (!args.has("quiet")) opt.log = [](const std::string& s) { std::fprintf(stderr, "softrne-loop: %s\n", s.c_str()); };
     fit::LoopResult r;
     try {
@@ -91,22 +86,30 @@ int main(int argc, char** argv) {
     {
       std::ofstream f(args.value("out"));
       if (!f) throw io::InputError(io::Category::WriteFailed, args.value("out"), "", "cannot write the report");
-      f << cli::loop_report_json(r, true).dump(2) << "\n";
+      f << cli::loop_report_json(r, true, opt).dump(2) << "\n";
     }
-    std::printf("closed loop in %.1f s\n", r.wall_seconds);
+    std::printf("closed loop in %.1f s (%d simulations)\n", r.wall_seconds, r.simulations);
+    std::printf("sensor noise estimated from the training angles: floor (median |error| of noise alone) %.4f rad\n",
+                r.noise_floor);
     for (std::size_t k = 0; k < r.rounds.size(); ++k) {
-      std::printf("round %zu: candidates ranked by the share of the residual they explain\n", k + 1);
+      std::printf("round %zu: candidates by predicted held-out gain (screen), refitted ones with the measured gain\n",
+                  k + 1);
+      int shown = 0;
       for (const auto& c : r.rounds[k]) {
-        std::printf("  %-22s %6.1f %%", c.name.c_str(), 100 * c.residual_explained);
-        if (c.confirmed && std::isfinite(c.fold_gains[0]) && std::isfinite(c.fold_gains[1]))
-          std::printf("   held-out error %+6.1f %% / %+6.1f %%", -100 * c.fold_gains[0], -100 * c.fold_gains[1]);
-        else if (c.confirmed)
-          std::printf("   refit failed to simulate in a fold: rejected");
-        std::printf("\n");
+        if (!c.confirmed && shown >= 8) continue;  // the full list is in the report
+        ++shown;
+        std::printf("  %-48s predicted", c.label.c_str());
+        for (double g : c.predicted_gains) std::printf(" %+6.1f %%", -100 * g);
+        if (c.confirmed) {
+          std::printf("   held-out");
+          for (double g : c.fold_gains) std::printf(" %+6.1f %%", -100 * g);
+        }
+        std::printf("%s\n", c.added ? "   -> added" : "");
       }
     }
     if (r.added.empty()) std::printf("no effect earned its place: the declared model stands\n");
-    for (const auto& a : r.added) std::printf("added %s: %s\n", effect_name(a.effect).c_str(), a.evidence.c_str());
+    for (const auto& a : r.added) std::printf("added %s: %s\n", a.label.c_str(), a.evidence.c_str());
+    std::printf("%s\n", r.unexplained_train.statement.c_str());
     std::printf("%s", cli::parameter_table(r.final_fit).c_str());
     std::printf("%s", format_error_table(r.baseline.stats, "train, baseline").c_str());
     std::printf("%s", format_error_table(r.final_train, "train, final").c_str());

@@ -2,6 +2,9 @@
 /// \file
 /// \brief JSON of error statistics and of the closed-loop report (formats.md section 5).
 
+#include <cmath>
+#include <string>
+
 #include <nlohmann/json.hpp>
 
 #include "softrne/fit/loop.hpp"
@@ -40,30 +43,70 @@ inline std::string parameter_table(const fit::ArmFitResult& r) {
   return out;
 }
 
-/// \brief The closed-loop report (format softrne-loop-report/1).
-inline nlohmann::ordered_json loop_report_json(const fit::LoopResult& r, bool has_test) {
+/// \brief Standard error of each named parameter of a fit (inf where not determined).
+inline double std_error_of(const fit::ArmFitResult& r, const std::string& name) {
+  for (int i = 0; i < r.parameters.size(); ++i)
+    if (r.parameters[i].name == name && r.fit.std_errors.size() > i) return r.fit.std_errors(i);
+  return INFINITY;
+}
+
+/// \brief JSON number, or null where it is not finite (JSON has no inf/NaN).
+inline nlohmann::ordered_json finite_or_null(double x) {
+  return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(nullptr);
+}
+
+inline nlohmann::ordered_json unexplained_json(const fit::UnexplainedResidual& u) {
   nlohmann::ordered_json j;
-  j["format"] = "softrne-loop-report/1";
+  j["above_floor"] = u.above_floor;
+  j["threshold"] = u.threshold;
+  j["statement"] = u.statement;
+  nlohmann::ordered_json per = nlohmann::ordered_json::object();
+  for (const auto& c : u.coordinates)
+    per[c.name] = {{"median", c.median},
+                   {"floor", c.floor},
+                   {"ratio", finite_or_null(c.ratio)},
+                   {"correlation", {{"q", c.corr_q}, {"qdot", c.corr_qdot}, {"drive", c.corr_drive},
+                                    {"drive_rate", c.corr_drive_rate}}},
+                   {"band_power", {{"below_0.5Hz", c.band_power.size() > 0 ? c.band_power[0] : 0.0},
+                                   {"0.5_2Hz", c.band_power.size() > 1 ? c.band_power[1] : 0.0},
+                                   {"2_10Hz", c.band_power.size() > 2 ? c.band_power[2] : 0.0},
+                                   {"above_10Hz", c.band_power.size() > 3 ? c.band_power[3] : 0.0}}}};
+  j["per_angle"] = per;
+  return j;
+}
+
+/// \brief The closed-loop report (format softrne-loop-report/2, formats.md section 5).
+inline nlohmann::ordered_json loop_report_json(const fit::LoopResult& r, bool has_test,
+                                               const fit::LoopOptions& opt = {}) {
+  nlohmann::ordered_json j;
+  j["format"] = "softrne-loop-report/2";
   nlohmann::ordered_json base;
   base["train"] = stats_json(r.baseline.stats);
   if (has_test) base["test"] = stats_json(r.baseline_test);
   j["baseline"] = base;
   nlohmann::ordered_json effects = nlohmann::ordered_json::array();
   const auto& d = r.final_fit.fitted;
+  // The added effects are the last r.added.size() effects of the final model, in order.
+  const std::size_t first = d.effects.size() >= r.added.size() ? d.effects.size() - r.added.size() : 0;
   for (std::size_t k = 0; k < r.added.size(); ++k) {
-    // The refitted parameters of the k-th added effect live in the final description.
-    const AnyEffect& e = d.effects.size() > k ? d.effects[k] : r.added[k].effect;
+    const AnyEffect& e = first + k < d.effects.size() ? d.effects[first + k] : r.added[k].effect;
     nlohmann::ordered_json x;
     x["name"] = effect_name(e);
+    x["scope"] = scope_name(effect_base(e).scope);
     nlohmann::ordered_json joints = nlohmann::ordered_json::array();
     for (int ji : effect_base(e).joints) joints.push_back(d.joints[static_cast<std::size_t>(ji)].name);
     x["joints"] = joints;
-    nlohmann::ordered_json params = nlohmann::ordered_json::object();
-    const auto names = effect_param_names(e, d.joints, d.coordinate_names);
-    for (std::size_t i = 0; i < names.size(); ++i) params[names[i]] = effect_base(e).params(static_cast<Eigen::Index>(i));
+    nlohmann::ordered_json params = nlohmann::ordered_json::object(), se = nlohmann::ordered_json::object();
+    const auto names = effect_param_names(e, d.joints, d.coordinate_names, d.pressure_names);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      params[names[i]] = effect_base(e).params(static_cast<Eigen::Index>(i));
+      se[names[i]] = finite_or_null(std_error_of(r.final_fit, effect_name(e) + "." + names[i]));
+    }
     x["params"] = params;
-    x["evidence"] = r.added[k].evidence;
+    x["std_errors"] = se;
+    x["fold_gains"] = r.added[k].fold_gains;
     x["selection_gain"] = r.added[k].selection_gain;
+    x["evidence"] = r.added[k].evidence;
     effects.push_back(x);
   }
   j["effects"] = effects;
@@ -71,21 +114,49 @@ inline nlohmann::ordered_json loop_report_json(const fit::LoopResult& r, bool ha
   fin["train"] = stats_json(r.final_train);
   if (has_test) fin["test"] = stats_json(r.final_test);
   j["final"] = fin;
+  nlohmann::ordered_json noise;
+  nlohmann::ordered_json sigma = nlohmann::ordered_json::object();
+  for (Eigen::Index k = 0; k < r.noise_sigma.size(); ++k)
+    sigma[d.coordinate_names[static_cast<std::size_t>(k)]] = r.noise_sigma(k);
+  noise["sigma"] = sigma;
+  noise["floor_median"] = r.noise_floor;
+  noise["method"] = "third differences of the measured training angles, median absolute value";
+  j["noise"] = noise;
+  nlohmann::ordered_json unexplained;
+  unexplained["train"] = unexplained_json(r.unexplained_train);
+  if (has_test) unexplained["test"] = unexplained_json(r.unexplained_test);
+  j["unexplained"] = unexplained;
+  j["selection"] = {{"rule", "an effect is added only if it lowers the held-out training error by at least "
+                             "min_gain in every fold"},
+                    {"min_gain", opt.min_gain},
+                    {"folds", r.folds},
+                    {"cv_blocks", opt.cv_blocks},
+                    {"false_positive_rate", fit::kCalibratedFalsePositiveRate}};
   nlohmann::ordered_json candidates = nlohmann::ordered_json::array();
   for (const auto& round : r.rounds) {
     nlohmann::ordered_json rj = nlohmann::ordered_json::array();
-    for (const auto& c : round)
+    for (const auto& c : round) {
+      nlohmann::ordered_json pg = nlohmann::ordered_json::array(), fg = nlohmann::ordered_json::array();
+      for (double g : c.predicted_gains) pg.push_back(finite_or_null(g));
+      for (double g : c.fold_gains) fg.push_back(finite_or_null(g));
       rj.push_back({{"name", c.name},
-                    {"residual_explained", c.residual_explained},
+                    {"label", c.label},
+                    {"scope", scope_name(c.scope)},
+                    {"joints", c.joints},
+                    {"predicted_gains", pg},
                     {"confirmed", c.confirmed},
-                    {"cv_gain", c.cv_gain},
-                    {"fold_gains", c.fold_gains}});
+                    {"fold_gains", fg},
+                    {"cv_gain", finite_or_null(c.cv_gain)},
+                    {"added", c.added}});
+    }
     candidates.push_back(rj);
   }
   j["candidates"] = candidates;
+  j["simulations"] = r.simulations;
+  j["wall_seconds"] = r.wall_seconds;
   io::RobotSpec fitted = to_robot_spec(d);
-  for (std::size_t k = 0; k < fitted.effects.size() && k < r.added.size(); ++k)
-    fitted.effects[k].evidence = r.added[k].evidence;
+  for (std::size_t k = 0; k < r.added.size() && first + k < fitted.effects.size(); ++k)
+    fitted.effects[first + k].evidence = r.added[k].evidence;
   j["fitted_robot"] = io::to_ordered_json(fitted);
   return j;
 }

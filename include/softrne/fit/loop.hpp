@@ -1,226 +1,116 @@
 #pragma once
 /// \file
-/// \brief The closed loop: fit the declared model, look at the residual, find the effect the
-/// model lacks, add it, refit, and measure the error before and after.
+/// \brief The closed loop: fit the declared model, find the effects it lacks by their
+/// HELD-OUT simulation error, add those that earn their place, refit, and say what is still
+/// unexplained.
 ///
 /// Method (docs/closing-the-loop.md):
-///  1. Baseline: fit stiffness and damping by simulation error on the training data.
-///  2. Residual: the equation error \f$r = M\ddot q + C\dot q + G - \tau(q,\dot q,p)\f$ on the
-///     measured trajectory (Savitzky-Golay smoothed q, qdot, qddot), where tau holds the
-///     declared springs, dampers, pressure torques and the effects added so far.
-///  3. Ranking: each candidate effect's generalised force is (to first order) linear in its
-///     parameter, \f$\tau_e \approx \theta\,\varphi_e(q,\dot q,p,\dot p)\f$. Regressing r on
-///     \f$\varphi_e\f$ together with nuisance regressors for re-estimated K and D gives the
-///     fraction of the residual each candidate explains beyond a stiffness/damping change.
-///  4. Confirmation: the best candidates (those that explain at least `min_explained` of the
-///     residual) are refitted in full (simulation error) and scored by
-///     two-fold cross-validation on the TRAINING data (interleaved time blocks: each fold is
-///     fitted on the other blocks, the simulation runs through all samples, the error is
-///     measured on the held-out blocks). An effect is added only if it lowers the held-out
-///     error by at least `min_gain` in every fold: a parameter that only fits noise cannot do
-///     that, so declared-model data gets no effect. Test data is never used to select.
-///  5. Repeat until no candidate earns its place.
+///  1. Baseline: stiffness and damping fitted by simulation error on all training data.
+///  2. Folds: the training record is cut into `cv_blocks` contiguous time blocks; fold f is
+///     fitted on the blocks b with b % 2 != f and measured on the others. Each fold has its own
+///     base model, fitted from the DECLARED model on the fold's training blocks alone (global
+///     stage included), so nothing a fold's decision uses has seen its held-out blocks.
+///  3. Screen (candidates.hpp): every effect, in every scope it allows, gets a linearised
+///     held-out gain per fold from sensitivities of the fold's simulated trajectory.
+///  4. Confirmation: the best `candidates_to_confirm` candidates are refitted in each fold (the
+///     effect with every stiffness, damping and effect already held, by simulation error on the
+///     fold's training blocks, from the fold's base model and the fold's own screening step),
+///     and the measured held-out RMS error is compared with the fold's base model.
+///  5. Significance rule: a candidate earns its place only if it lowers the held-out error by
+///     at least `min_gain` in EVERY fold; the best such candidate (largest mean gain) is added,
+///     the full model is refitted on all training data, and the winner's fold refits become
+///     the folds' base models for the next round (so each later effect must earn its place
+///     against a model that already holds the others). At most `max_effects` rounds.
+///  6. The sensor noise floor is estimated from the data (noise_floor.hpp) and the final
+///     residual analysed (residual_analysis.hpp): the report says which coordinates stay above
+///     the floor and what their residual correlates with, and names no effect for them.
+/// The test data never selects; it only measures.
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/QR>
 
 #include "softrne/fit/arm_fit.hpp"
-#include "softrne/fit/savitzky_golay.hpp"
+#include "softrne/fit/candidates.hpp"
+#include "softrne/fit/noise_floor.hpp"
+#include "softrne/fit/residual_analysis.hpp"
 
 namespace softrne::fit {
+
+/// \brief The measured false-positive rate of the significance rule with the default options:
+/// effect-free random arms (tools/score-loop.py, docs/closing-the-loop.md) that got any effect.
+inline constexpr const char* kCalibratedFalsePositiveRate = "not yet measured";
 
 /// \brief Settings of the closed loop.
 struct LoopOptions {
   ArmFitOptions fit{};
-  int max_effects = 3;
-  int candidates_to_confirm = 3;  ///< best-ranked candidates refitted per round
-  double min_gain = 0.05;         ///< relative drop of the held-out error, in every fold
-  /// Candidates that explain less of the equation-error residual than this are not refitted
-  /// (a term that explains almost none of the residual cannot lower the error by min_gain).
-  double min_explained = 0.02;
-  int cv_blocks = 4;              ///< contiguous time blocks; folds take every other block
-  SgOptions smoothing{};          ///< differentiator of the measured angles and pressures
+  int max_effects = 4;
+  int candidates_to_confirm = 3;  ///< best-screened candidates refitted per round
+  /// Relative drop of the held-out error a candidate must reach in every fold. Its
+  /// false-positive rate on effect-free data is measured in docs/closing-the-loop.md.
+  double min_gain = 0.05;
+  /// Candidates whose predicted gain (the screen) is below this in any fold are not refitted.
+  double min_predicted_gain = 0.01;
+  int cv_blocks = 4;  ///< contiguous time blocks; fold f holds out the blocks b % 2 == f
+  /// Local evaluations of a confirmation refit (each is one simulation of the record).
+  int refit_evals = 120;
+  /// A coordinate whose final median error exceeds this multiple of the noise floor is
+  /// reported as unexplained.
+  double unexplained_ratio = 1.5;
   std::function<void(const std::string&)> log;  ///< progress lines (may be empty)
 };
 
-/// \brief One candidate's evidence.
+/// \brief One candidate's evidence in one round.
 struct CandidateScore {
-  std::string name;
-  double residual_explained = 0;  ///< fraction of the equation-error residual (after K, D)
-  Eigen::VectorXd estimate;       ///< regression estimate of its parameter(s)
-  bool confirmed = false;
-  double cv_gain = 0;             ///< relative drop of the held-out simulation error
-  std::vector<double> fold_gains;
+  std::string name;   ///< the effect's name
+  std::string label;  ///< name, scope and joints (and fixed secondary values)
+  Scope scope = Scope::Shared;
+  std::vector<std::string> joints;
+  std::vector<double> predicted_gains;  ///< the screen, per fold
+  bool confirmed = false;               ///< refitted in the folds
+  std::vector<double> fold_gains;       ///< measured relative drop of the held-out error
+  double cv_gain = 0;                   ///< mean of fold_gains
+  bool added = false;
 };
 
 /// \brief An effect the loop added.
 struct AddedEffect {
-  AnyEffect effect;
+  AnyEffect effect;  ///< as first added (the refitted values are in LoopResult::final_fit)
+  std::string label;
   std::string evidence;
-  double selection_gain = 0;
+  std::vector<double> fold_gains;
+  double selection_gain = 0;  ///< mean held-out gain in the round it was added
 };
 
 /// \brief Outcome of run_loop.
 struct LoopResult {
   ArmFitResult baseline;
   ErrorStats baseline_test, final_train, final_test;
-  std::vector<std::vector<CandidateScore>> rounds;  ///< ranked candidates of each round
+  std::vector<std::vector<CandidateScore>> rounds;  ///< candidates of each round, best first
   std::vector<AddedEffect> added;
   ArmFitResult final_fit;
-  Eigen::MatrixXd residual;   ///< equation error of the baseline on train (N x nq)
-  Eigen::MatrixXd final_residual;
+  Eigen::VectorXd noise_sigma;  ///< estimated sensor noise per coordinate (rad)
+  double noise_floor = 0;       ///< median |error| that noise alone gives (rad), all coordinates
+  UnexplainedResidual unexplained_train, unexplained_test;
+  Eigen::MatrixXd baseline_residual;  ///< measured - simulated on train, baseline (N x nq)
+  Eigen::MatrixXd final_residual;     ///< the same after the loop
+  int folds = 2;
+  int simulations = 0;
   double wall_seconds = 0;
 };
 
 namespace detail {
 
-/// Measured trajectory, smoothed and differentiated.
-struct Trajectory {
-  Eigen::MatrixXd q, qd, qdd, p, pd;
-};
-
-inline Trajectory differentiate(const io::Dataset& d, const SgOptions& sg) {
-  Trajectory tr;
-  Eigen::MatrixXd pdd;
-  savgol(d.t, d.angles, sg, tr.q, tr.qd, tr.qdd);
-  savgol(d.t, d.pressures, sg, tr.p, tr.pd, pdd);
-  return tr;
-}
-
-/// Equation error r = M qdd + C qd + G - tau(q, qd, p) for every sample (N x nq).
-inline Eigen::MatrixXd equation_error(const ArmDescription& desc, const Trajectory& tr) {
-  ArmDynamics<double> dyn(desc);
-  auto chain = desc.make_chain<double>();
-  auto data = chain.make_data();
-  const Eigen::Index N = tr.q.rows();
-  Eigen::MatrixXd r(N, desc.nq);
-  const Eigen::VectorXd offset = desc.measurement_offset();
-  for (Eigen::Index i = 0; i < N; ++i) {
-    const Eigen::VectorXd q = tr.q.row(i).transpose() - offset, qd = tr.qd.row(i).transpose(),
-                          qdd = tr.qdd.row(i).transpose(), p = tr.p.row(i).transpose();
-    const Eigen::VectorXd tau = dyn.joint_forces(q, qd, p);
-    r.row(i) = (rnea(chain, data, q, qd, qdd) - tau).transpose();
-  }
-  return r;
-}
-
-/// A candidate effect on every joint it applies to, shared parameter.
-inline AnyEffect make_candidate(const std::string& name, const ArmDescription& d) {
-  AnyEffect e;
-  make_effect(name, e);
-  EffectBase& b = effect_base(e);
-  for (std::size_t j = 0; j < d.joints.size(); ++j) {
-    if (std::holds_alternative<ChamberMisalignment>(e) && !d.joints[j].is_cc()) continue;
-    if ((std::holds_alternative<ActuatorLag>(e) || std::holds_alternative<PressureStiffening>(e)) &&
-        d.joints[j].num_inputs == 0)
-      continue;
-    b.joints.push_back(static_cast<int>(j));
-  }
-  b.shared = !std::holds_alternative<AngleOffset>(e);
-  b.params = Eigen::VectorXd::Zero(effect_num_params(e, d.joints));
-  return e;
-}
-
-/// Regressors of a candidate: d tau_effect / d theta at theta = 0 (N*nq x n_params), with
-/// tau_effect the force the effect adds to the right-hand side; the declared model's equation
-/// error is then r ~ Phi theta.
-inline Eigen::MatrixXd candidate_regressors(const ArmDescription& base, const AnyEffect& cand,
-                                            const Trajectory& tr) {
-  const Eigen::Index N = tr.q.rows();
-  const int nq = base.nq;
-  const int np = effect_num_params(cand, base.joints);
-  Eigen::MatrixXd Phi = Eigen::MatrixXd::Zero(N * nq, np);
-  const Eigen::VectorXd offset = base.measurement_offset();
-  if (std::holds_alternative<ActuatorLag>(cand)) {
-    // p_eff = p - T pdot + O(T^2): d tau/dT = -K_prs pdot.
-    for (Eigen::Index i = 0; i < N; ++i)
-      for (int jj : effect_base(cand).joints) {
-        const ArmJoint& j = base.joints[static_cast<std::size_t>(jj)];
-        for (int k = 0; k < j.nq; ++k)
-          for (int c = 0; c < j.num_inputs; ++c)
-            Phi(i * nq + j.q_offset + k, 0) -= j.pressure_to_torque(k, c) * tr.pd(i, j.input_offset + c);
-      }
-    return Phi;
-  }
-  if (std::holds_alternative<AngleOffset>(cand)) {
-    // Measured = q + b, so the residual computed with measured angles shifts by
-    // -(d r/dq) b; d r/dq by central differences of the equation error.
-    auto chain = base.make_chain<double>();
-    auto data = chain.make_data();
-    ArmDynamics<double> dyn(base);
-    const double h = 1e-6;
-    int col = 0;
-    for (int jj : effect_base(cand).joints) {
-      const ArmJoint& j = base.joints[static_cast<std::size_t>(jj)];
-      for (int k = 0; k < j.nq; ++k, ++col)
-        for (Eigen::Index i = 0; i < N; ++i) {
-          Eigen::VectorXd q = tr.q.row(i).transpose() - offset;
-          const Eigen::VectorXd qd = tr.qd.row(i).transpose(), qdd = tr.qdd.row(i).transpose(),
-                                p = tr.p.row(i).transpose();
-          q(j.q_offset + k) += h;
-          Eigen::VectorXd rp = rnea(chain, data, q, qd, qdd) - dyn.joint_forces(q, qd, p);
-          q(j.q_offset + k) -= 2 * h;
-          Eigen::VectorXd rm = rnea(chain, data, q, qd, qdd) - dyn.joint_forces(q, qd, p);
-          // r(q_meas - b) = r(q_meas) - (dr/dq) b: the added force is +(dr/dq) b.
-          Phi.block(i * nq, col, nq, 1) = (rp - rm) / (2 * h);
-        }
-    }
-    return Phi;
-  }
-  // Every other effect: finite difference of the model's joint forces (or of the RNE for a
-  // payload) in its parameter around zero; exact for effects linear in it.
-  const double h = std::holds_alternative<ChamberMisalignment>(cand) ? 1e-6 : 1e-3;
-  ArmDescription with = base, without = base;
-  AnyEffect e = cand;
-  effect_base(e).params.setConstant(h);
-  with.effects.push_back(e);
-  with.effect_state_offsets.push_back(with.num_effect_states);
-  ArmDynamics<double> dyn_with(with), dyn_without(without);
-  auto chain_with = with.make_chain<double>();
-  auto data_with = chain_with.make_data();
-  auto chain_without = without.make_chain<double>();
-  auto data_without = chain_without.make_data();
-  const bool payload = std::holds_alternative<Payload>(cand);
-  for (Eigen::Index i = 0; i < N; ++i) {
-    const Eigen::VectorXd q = tr.q.row(i).transpose() - offset, qd = tr.qd.row(i).transpose(),
-                          qdd = tr.qdd.row(i).transpose(), p = tr.p.row(i).transpose();
-    Eigen::VectorXd d = dyn_with.joint_forces(q, qd, p) - dyn_without.joint_forces(q, qd, p);
-    if (payload) {
-      const Eigen::VectorXd a = rnea(chain_with, data_with, q, qd, qdd);
-      d -= a - rnea(chain_without, data_without, q, qd, qdd);  // inertia is on the left side
-    }
-    Phi.block(i * nq, 0, nq, 1) = d / h;
-  }
-  return Phi;
-}
-
-/// Nuisance regressors: re-estimated stiffness and damping (q_k and qdot_k on coordinate k).
-inline Eigen::MatrixXd nuisance_regressors(const ArmDescription& d, const Trajectory& tr) {
-  const Eigen::Index N = tr.q.rows();
-  const int nq = d.nq;
-  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(N * nq, 2 * nq);
-  for (Eigen::Index i = 0; i < N; ++i)
-    for (int k = 0; k < nq; ++k) {
-      X(i * nq + k, 2 * k) = tr.q(i, k);
-      X(i * nq + k, 2 * k + 1) = tr.qd(i, k);
-    }
-  return X;
-}
-
-inline double rss_after(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, Eigen::VectorXd* coef = nullptr) {
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X);
-  const Eigen::VectorXd c = qr.solve(y);
-  if (coef) *coef = c;
-  return (y - X * c).squaredNorm();
-}
-
-/// RMS of the simulation error over the masked samples.
-inline double masked_rms(const Eigen::MatrixXd& sim, const Eigen::MatrixXd& meas, const std::vector<bool>& mask) {
+/// RMS of measured - simulated over the masked samples.
+inline double masked_rms(const Eigen::MatrixXd& sim, const Eigen::MatrixXd& meas,
+                         const std::vector<bool>& mask) {
   double s = 0;
   long n = 0;
   for (Eigen::Index i = 0; i < std::min(sim.rows(), meas.rows()); ++i)
@@ -228,152 +118,245 @@ inline double masked_rms(const Eigen::MatrixXd& sim, const Eigen::MatrixXd& meas
       s += (sim.row(i) - meas.row(i)).squaredNorm();
       n += sim.cols();
     }
-  return n ? std::sqrt(s / static_cast<double>(n)) : 0.0;
+  return n ? std::sqrt(s / static_cast<double>(n)) : std::numeric_limits<double>::infinity();
+}
+
+/// One cross-validation fold: its masks, base model and that model's held-out error.
+struct Fold {
+  std::vector<bool> fit_rows, held_rows;
+  ArmDescription model;
+  Eigen::MatrixXd angles;  ///< simulated
+  double held_rms = std::numeric_limits<double>::infinity();
+};
+
+inline std::vector<Fold> make_folds(Eigen::Index N, int blocks) {
+  std::vector<Fold> folds(2);
+  blocks = std::max(2, blocks);
+  for (int f = 0; f < 2; ++f) {
+    folds[static_cast<std::size_t>(f)].fit_rows.resize(static_cast<std::size_t>(N));
+    folds[static_cast<std::size_t>(f)].held_rows.resize(static_cast<std::size_t>(N));
+    for (Eigen::Index i = 0; i < N; ++i) {
+      const bool held = static_cast<int>((i * blocks) / N) % 2 == f;
+      folds[static_cast<std::size_t>(f)].held_rows[static_cast<std::size_t>(i)] = held;
+      folds[static_cast<std::size_t>(f)].fit_rows[static_cast<std::size_t>(i)] = !held;
+    }
+  }
+  return folds;
+}
+
+inline std::string percent(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%+.1f %%", -100 * x);
+  return b;
 }
 
 }  // namespace detail
 
-/// \brief Runs the closed loop on a training set; `test` only measures (may be empty).
+/// \brief Runs the closed loop on a training set; `test` only measures (may be null).
 inline LoopResult run_loop(const ArmDescription& declared, const io::Dataset& train,
                            const io::Dataset* test, const LoopOptions& opt = {}) {
   const auto t0 = std::chrono::steady_clock::now();
   auto log = [&](const std::string& s) {
     if (opt.log) opt.log(s);
   };
+  check_fit_data(declared, train);
   LoopResult out;
+  const int threads = std::max(1, opt.fit.optimiser.threads);
+  const sim::ArmSimulationOptions& sim_opt = opt.fit.simulation;
+  const Eigen::Index N = train.t.size();
+
+  out.noise_sigma = estimate_noise_sigma(train.angles);
+  out.noise_floor = noise_floor_median(std::sqrt(out.noise_sigma.squaredNorm() /
+                                                 std::max<Eigen::Index>(1, out.noise_sigma.size())));
+
   log("baseline fit of stiffness and damping");
   out.baseline = fit_arm(declared, train, opt.fit);
+  out.simulations += out.baseline.simulations;
   auto test_stats = [&](const ArmDescription& d) {
     ErrorStats s;
     if (!test) return s;
-    const auto sim = simulate_dataset(d, *test, opt.fit.simulation);
+    const auto sim = simulate_dataset(d, *test, sim_opt);
     if (sim.ok()) s = error_stats(sim.angles, test->angles, d.coordinate_names);
     return s;
   };
   out.baseline_test = test_stats(out.baseline.fitted);
-  const detail::Trajectory tr = detail::differentiate(train, opt.smoothing);
-  const Eigen::Index N = train.t.size();
 
-  // Folds: interleaved contiguous time blocks.
-  std::vector<std::vector<bool>> fit_masks(2), held_masks(2);
-  for (int f = 0; f < 2; ++f) {
-    fit_masks[f].resize(static_cast<std::size_t>(N));
-    held_masks[f].resize(static_cast<std::size_t>(N));
-    for (Eigen::Index i = 0; i < N; ++i) {
-      const int block = static_cast<int>((i * opt.cv_blocks) / N);
-      const bool held = block % 2 == f;
-      held_masks[f][static_cast<std::size_t>(i)] = held;
-      fit_masks[f][static_cast<std::size_t>(i)] = !held;
-    }
+  // Fold base models, each fitted from the declared model on its own training blocks.
+  std::vector<detail::Fold> folds = detail::make_folds(N, opt.cv_blocks);
+  for (std::size_t f = 0; f < folds.size(); ++f) {
+    log("fold " + std::to_string(f + 1) + ": base fit on its training blocks");
+    ArmFitOptions o = opt.fit;
+    o.sample_mask = folds[f].fit_rows;
+    o.optimiser.compute_identifiability = false;
+    const ArmFitResult r = fit_arm(declared, train, o);
+    out.simulations += r.simulations;
+    folds[f].model = r.fitted;
+    folds[f].angles = detail::simulated_angles(r.fitted, train, sim_opt);
+    folds[f].held_rms = folds[f].angles.size()
+                            ? detail::masked_rms(folds[f].angles, train.angles, folds[f].held_rows)
+                            : std::numeric_limits<double>::infinity();
   }
-  // Refits start from the current fit (warm start): local stage only.
+
   ArmFitOptions refit = opt.fit;
   refit.optimiser.global_evals = 0;
-  auto cv_errors = [&](const ArmDescription& d) {
-    std::vector<double> e(2);
-    for (int f = 0; f < 2; ++f) {
-      ArmFitOptions o = refit;
-      o.sample_mask = fit_masks[f];
-      const ArmFitResult r = fit_arm(d, train, o);
-      const auto sim = simulate_dataset(r.fitted, train, opt.fit.simulation);
-      e[static_cast<std::size_t>(f)] = sim.ok() ? detail::masked_rms(sim.angles, train.angles, held_masks[f])
-                                                : std::numeric_limits<double>::infinity();
-    }
-    return e;
-  };
+  refit.optimiser.multistart_starts = 1;
+  refit.optimiser.local_evals = opt.refit_evals;
+  refit.optimiser.compute_identifiability = false;
 
-  ArmDescription current = out.baseline.fitted;
   ArmFitResult current_fit = out.baseline;
-  std::vector<std::string> used;
-  std::vector<double> base_cv;  // held-out errors of the current model (reused across rounds)
+  ArmDescription current = out.baseline.fitted;
   for (int round = 0; round < opt.max_effects; ++round) {
-    const Eigen::MatrixXd R = detail::equation_error(current, tr);
-    if (round == 0) out.residual = R;
-    Eigen::VectorXd y(R.size());
-    for (Eigen::Index i = 0; i < N; ++i) y.segment(i * current.nq, current.nq) = R.row(i).transpose();
-    const Eigen::MatrixXd X0 = detail::nuisance_regressors(current, tr);
-    const double rss0 = detail::rss_after(X0, y);
+    bool folds_ok = true;
+    for (const auto& f : folds) folds_ok = folds_ok && f.angles.size() > 0 && std::isfinite(f.held_rms);
+    if (!folds_ok) {
+      log("a fold's base model fails to simulate: no effect can be judged");
+      break;
+    }
+    // Candidates on the current structure (the folds' models share it).
+    const std::vector<AnyEffect> raw = enumerate_candidates(current);
+    const std::vector<Candidate> cands =
+        expand_secondary_kinds(raw, folds[0].model, folds[0].angles, train, sim_opt, threads, &out.simulations);
+    std::vector<std::vector<FoldScreen>> screens;
+    for (const auto& f : folds)
+      screens.push_back(screen_fold(cands, f.model, f.angles, train, f.fit_rows, f.held_rows, sim_opt, threads,
+                                    &out.simulations));
+    // Order by the worst fold's predicted gain; keep the best variant of each candidate.
+    std::vector<std::size_t> order(cands.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    auto worst = [&](std::size_t c) {
+      double g = std::numeric_limits<double>::infinity();
+      for (const auto& s : screens) g = std::min(g, s[c].predicted_gain);
+      return g;
+    };
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return worst(a) > worst(b); });
     std::vector<CandidateScore> scores;
-    for (const std::string& name : effect_names()) {
-      if (std::find(used.begin(), used.end(), name) != used.end()) continue;
-      const AnyEffect cand = detail::make_candidate(name, current);
-      if (effect_base(cand).joints.empty()) continue;
-      const Eigen::MatrixXd Phi = detail::candidate_regressors(current, cand, tr);
-      if (!Phi.allFinite() || Phi.norm() == 0) continue;
-      Eigen::MatrixXd X(X0.rows(), X0.cols() + Phi.cols());
-      X << X0, Phi;
-      Eigen::VectorXd coef;
-      const double rss = detail::rss_after(X, y, &coef);
+    std::vector<std::size_t> score_cand;
+    std::vector<std::string> seen;
+    for (std::size_t c : order) {
+      const std::string key = candidate_label(cands[c].effect, current);
+      if (std::find(seen.begin(), seen.end(), key) != seen.end()) continue;
+      seen.push_back(key);
       CandidateScore s;
-      s.name = name;
-      s.residual_explained = rss0 > 0 ? (rss0 - rss) / rss0 : 0.0;
-      // r = tau_effect = Phi theta: the coefficient estimates the parameter.
-      s.estimate = coef.tail(Phi.cols());
+      s.name = effect_name(cands[c].effect);
+      s.label = cands[c].label;
+      s.scope = effect_base(cands[c].effect).scope;
+      for (int j : effect_base(cands[c].effect).joints) s.joints.push_back(current.joints[static_cast<std::size_t>(j)].name);
+      for (const auto& sc : screens) s.predicted_gains.push_back(sc[c].predicted_gain);
       scores.push_back(s);
+      score_cand.push_back(c);
     }
-    std::sort(scores.begin(), scores.end(),
-              [](const CandidateScore& a, const CandidateScore& b) { return a.residual_explained > b.residual_explained; });
-    log("round " + std::to_string(round + 1) + ": ranked " + std::to_string(scores.size()) + " candidates");
-    int best = -1;
-    double best_gain = 0;
-    ArmDescription best_desc;
-    std::vector<double> best_cv;
-    for (int c = 0; c < std::min<int>(opt.candidates_to_confirm, static_cast<int>(scores.size())); ++c) {
-      CandidateScore& s = scores[static_cast<std::size_t>(c)];
-      if (s.residual_explained < opt.min_explained) break;  // sorted: the rest explain less
-      if (base_cv.empty()) base_cv = cv_errors(current);
-      ArmDescription with = current;
-      AnyEffect e = detail::make_candidate(s.name, current);
-      const EffectBounds b = effect_bounds(e, current.segment_mass());
-      Eigen::VectorXd init = s.estimate;
-      for (Eigen::Index k = 0; k < init.size(); ++k) {
-        double v = std::isfinite(init(k)) ? init(k) : 0.0;
-        v = std::clamp(v, b.lower, b.upper);
-        if (b.log_scale) v = std::max(v, std::sqrt(b.lower * b.upper) * 0.1);
-        init(k) = v;
-      }
-      effect_base(e).params = init;
-      with.effects.push_back(e);
-      with.effect_state_offsets.push_back(with.num_effect_states);
-      with.num_effect_states += std::visit([&](const auto& x) { return x.num_states(with.joints); }, e);
-      const std::vector<double> cv = cv_errors(with);
+    log("round " + std::to_string(round + 1) + ": screened " + std::to_string(cands.size()) +
+        " candidates (" + std::to_string(scores.size()) + " effect/scope pairs)");
+
+    std::vector<std::vector<ArmFitResult>> fold_fits(scores.size());
+    std::vector<int> passing;
+    for (std::size_t r = 0; r < scores.size() && static_cast<int>(r) < opt.candidates_to_confirm; ++r) {
+      CandidateScore& s = scores[r];
+      if (worst(score_cand[r]) < opt.min_predicted_gain) break;  // ordered: the rest predict less
+      const Candidate& cand = cands[score_cand[r]];
+      std::vector<ArmFitResult> fits;
       s.confirmed = true;
-      s.fold_gains = {(base_cv[0] - cv[0]) / base_cv[0], (base_cv[1] - cv[1]) / base_cv[1]};
-      s.cv_gain = ((base_cv[0] + base_cv[1]) - (cv[0] + cv[1])) / (base_cv[0] + base_cv[1]);
-      if (std::isfinite(s.cv_gain))
-        log("  " + s.name + ": explains " + std::to_string(100 * s.residual_explained) + " % of the residual, held-out error " +
-            std::to_string(100 * s.fold_gains[0]) + " % / " + std::to_string(100 * s.fold_gains[1]) + " % lower");
-      else
-        log("  " + s.name + ": explains " + std::to_string(100 * s.residual_explained) +
-            " % of the residual; its refit failed to simulate in a fold: rejected");
-      const bool significant = s.fold_gains[0] >= opt.min_gain && s.fold_gains[1] >= opt.min_gain;
-      if (significant && s.cv_gain > best_gain) {
-        best = c;
-        best_gain = s.cv_gain;
-        best_desc = with;
-        best_cv = cv;
+      for (std::size_t f = 0; f < folds.size(); ++f) {
+        AnyEffect e = cand.effect;
+        effect_base(e).params = screens[f][score_cand[r]].start;
+        ArmFitOptions o = refit;
+        o.sample_mask = folds[f].fit_rows;
+        const ArmFitResult fr = fit_arm(detail::with_effect(folds[f].model, e), train, o);
+        out.simulations += fr.simulations;
+        const Eigen::MatrixXd y = detail::simulated_angles(fr.fitted, train, sim_opt);
+        const double held = y.size() ? detail::masked_rms(y, train.angles, folds[f].held_rows)
+                                     : std::numeric_limits<double>::infinity();
+        s.fold_gains.push_back(std::isfinite(held) ? 1.0 - held / folds[f].held_rms
+                                                   : -std::numeric_limits<double>::infinity());
+        fits.push_back(fr);
       }
+      double sum = 0, mn = std::numeric_limits<double>::infinity();
+      for (double g : s.fold_gains) {
+        sum += g;
+        mn = std::min(mn, g);
+      }
+      s.cv_gain = sum / static_cast<double>(s.fold_gains.size());
+      std::string line = "  " + s.label + ": held-out error";
+      for (double g : s.fold_gains) line += " " + detail::percent(g);
+      log(line);
+      fold_fits[r] = fits;
+      if (mn >= opt.min_gain) passing.push_back(static_cast<int>(r));
     }
+    // The best passing candidate; a simpler one (fewer parameters) wins if its remaining
+    // held-out error is within min_gain of the best's, the same margin every effect must earn.
+    int best = -1;
+    auto n_params = [&](int r) {
+      return effect_base(cands[score_cand[static_cast<std::size_t>(r)]].effect).params.size();
+    };
+    for (int r : passing)
+      if (best < 0 || scores[static_cast<std::size_t>(r)].cv_gain > scores[static_cast<std::size_t>(best)].cv_gain) best = r;
+    if (best >= 0) {
+      const double remaining = 1.0 - scores[static_cast<std::size_t>(best)].cv_gain;
+      int simplest = best;
+      for (int r : passing) {
+        const double rem = 1.0 - scores[static_cast<std::size_t>(r)].cv_gain;
+        if (n_params(r) < n_params(simplest) && rem <= remaining * (1.0 + opt.min_gain)) simplest = r;
+      }
+      best = simplest;
+    }
+    if (best < 0) {
+      out.rounds.push_back(scores);
+      break;
+    }
+    CandidateScore& w = scores[static_cast<std::size_t>(best)];
+    w.added = true;
     out.rounds.push_back(scores);
-    if (best < 0) break;
-    const CandidateScore& w = scores[static_cast<std::size_t>(best)];
-    log("adding " + w.name);
+    log("adding " + w.label);
+    // Full-data refit from the current model with the effect at the mean of the folds' values.
+    const std::vector<ArmFitResult>& best_fold_fits = fold_fits[static_cast<std::size_t>(best)];
+    AnyEffect e = cands[score_cand[static_cast<std::size_t>(best)]].effect;
+    Eigen::VectorXd mean = Eigen::VectorXd::Zero(effect_base(e).params.size());
+    for (const auto& fr : best_fold_fits) mean += effect_base(fr.fitted.effects.back()).params;
+    effect_base(e).params = mean / static_cast<double>(best_fold_fits.size());
     ArmFitOptions full = refit;
-    current_fit = fit_arm(best_desc, train, full);
+    full.optimiser.local_evals = opt.fit.optimiser.local_evals;
+    full.optimiser.compute_identifiability = true;  // standard errors for the report
+    current_fit = fit_arm(detail::with_effect(current, e), train, full);
+    out.simulations += current_fit.simulations;
     current = current_fit.fitted;
-    base_cv = best_cv;
-    used.push_back(w.name);
-    char ev[256];
-    std::snprintf(ev, sizeof ev,
-                  "explains %.0f%% of the equation-error residual beyond K and D; held-out training error "
-                  "%.0f%% and %.0f%% lower in the two folds",
-                  100 * w.residual_explained, 100 * w.fold_gains[0], 100 * w.fold_gains[1]);
-    out.added.push_back({current.effects.back(), ev, w.cv_gain});
+    for (std::size_t f = 0; f < folds.size(); ++f) {
+      folds[f].model = best_fold_fits[f].fitted;
+      folds[f].angles = detail::simulated_angles(folds[f].model, train, sim_opt);
+      folds[f].held_rms = folds[f].angles.size()
+                              ? detail::masked_rms(folds[f].angles, train.angles, folds[f].held_rows)
+                              : std::numeric_limits<double>::infinity();
+    }
+    AddedEffect a;
+    a.effect = e;
+    a.label = w.label;
+    a.fold_gains = w.fold_gains;
+    a.selection_gain = w.cv_gain;
+    a.evidence = "held-out training error";
+    for (std::size_t f = 0; f < w.fold_gains.size(); ++f)
+      a.evidence += (f ? ", " : " ") + detail::percent(w.fold_gains[f]);
+    a.evidence += " in the " + std::to_string(w.fold_gains.size()) +
+                  " folds against the model without it (fold models fitted on their own training blocks)";
+    out.added.push_back(a);
   }
+
   out.final_fit = current_fit;
   out.final_train = current_fit.stats;
   out.final_test = test_stats(current);
-  out.final_residual = detail::equation_error(current, tr);
+  auto residual = [&](const ArmDescription& d, const io::Dataset& data) {
+    const Eigen::MatrixXd y = detail::simulated_angles(d, data, sim_opt);
+    return y.size() ? Eigen::MatrixXd(data.angles - y) : Eigen::MatrixXd();
+  };
+  out.baseline_residual = residual(out.baseline.fitted, train);
+  out.final_residual = residual(current, train);
+  if (out.final_residual.size())
+    out.unexplained_train = analyse_residual(current, train.t, train.angles, train.angles - out.final_residual,
+                                             train.pressures, out.noise_sigma, opt.unexplained_ratio);
+  if (test && test->has_angles) {
+    const Eigen::MatrixXd rt = residual(current, *test);
+    if (rt.size())
+      out.unexplained_test = analyse_residual(current, test->t, test->angles, test->angles - rt, test->pressures,
+                                              out.noise_sigma, opt.unexplained_ratio);
+  }
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -510,7 +510,7 @@ inline RobotSpec robot_from_json(const nlohmann::json& j, const std::string& sou
   const std::string format = r.string("format");
   if (format != kRobotFormat) {
     std::string hint;
-    if (format == "softrne-loop-report/1")
+    if (format.rfind("softrne-loop-report/", 0) == 0)
       hint = " (this is a loop report; its robot is the field 'fitted_robot')";
     throw InputError(
         Category::UnknownFormat, source, r.fw("format"),

@@ -1,0 +1,47 @@
+#pragma once
+/// \file
+/// \brief Runs independent tasks on a few threads (the closed loop's screening simulations).
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <functional>
+#include <thread>
+#include <vector>
+
+namespace softrne::fit {
+
+/// \brief Calls `task(k)` for k = 0..n-1 on up to `threads` threads (the caller is one of
+/// them). Task k must write only its own outputs. The first exception thrown by a task stops
+/// the handing out of further tasks and is rethrown here after all threads joined.
+inline void parallel_for(int n, int threads, const std::function<void(int)>& task) {
+  const int workers = std::max(1, std::min(threads, n));
+  if (workers == 1) {
+    for (int k = 0; k < n; ++k) task(k);
+    return;
+  }
+  std::atomic<int> next{0};
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(workers));
+  auto work = [&](int w) {
+    try {
+      for (int k = next++; k < n; k = next++) task(k);
+    } catch (...) {
+      errors[static_cast<std::size_t>(w)] = std::current_exception();
+      next = n;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int w = 1; w < workers; ++w) {
+    try {
+      pool.emplace_back(work, w);
+    } catch (...) {
+      break;  // no thread to be had: the others take its share
+    }
+  }
+  work(0);
+  for (std::thread& t : pool) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace softrne::fit

@@ -1,0 +1,162 @@
+// The closed loop's parts against references that do not share their code: the noise
+// estimate against the known sigma of generated noise, the residual analysis against signals
+// built to correlate with one feature, the folds against their definition, the candidate list
+// against the effects' own scope tables, and the screen against the exact gain of a linear
+// measurement effect.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+#include "softrne/fit/loop.hpp"
+#include "synthetic_arm.hpp"
+
+namespace {
+
+using namespace softrne;
+
+TEST(NoiseFloor, RecoversSigmaOfWhiteNoiseOnASmoothSignal) {
+  std::mt19937 rng(3);
+  const int n = 6000;
+  for (double sigma : {0.001, 0.003, 0.01}) {
+    std::normal_distribution<double> noise(0.0, sigma);
+    Eigen::MatrixXd y(n, 2);
+    for (int i = 0; i < n; ++i) {
+      const double t = 0.01 * i;
+      y(i, 0) = 0.4 * std::sin(2.1 * t) + noise(rng);
+      y(i, 1) = 0.3 * std::tanh(std::sin(0.7 * t) * 4) + noise(rng);
+    }
+    const Eigen::VectorXd s = fit::estimate_noise_sigma(y);
+    // Standard error of a median-based estimate from n samples: ~1.25 sigma / sqrt(n) -> 2 %.
+    EXPECT_NEAR(s(0) / sigma, 1.0, 0.06) << sigma;
+    EXPECT_NEAR(s(1) / sigma, 1.0, 0.06) << sigma;
+  }
+  EXPECT_NEAR(fit::noise_floor_median(1.0), 0.6745, 1e-4);
+}
+
+TEST(NoiseFloor, PressureStepsDoNotInflateTheEstimate) {
+  // A step signal (jumps of 0.5 rad every 200 samples, each smoothed over 3 samples) plus noise:
+  // the median ignores the few large third differences at the steps.
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  Eigen::MatrixXd y(4000, 1);
+  double level = 0, target = 0;
+  for (int i = 0; i < 4000; ++i) {
+    if (i % 200 == 0) target = (i / 200) % 2 ? 0.5 : -0.2;
+    level += (target - level) * 0.3;
+    y(i, 0) = level + noise(rng);
+  }
+  EXPECT_NEAR(fit::estimate_noise_sigma(y)(0) / 0.003, 1.0, 0.1);
+}
+
+TEST(ResidualAnalysis, NoiseIsAtTheFloorAndASignalAboveIt) {
+  const ArmDescription d = build_arm(softrne_test::two_joint_spec());
+  const int n = 2000;
+  Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) * 0.01);
+  Eigen::MatrixXd sim(n, d.nq), meas(n, d.nq), p = Eigen::MatrixXd::Zero(n, d.num_inputs);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < d.nq; ++k) {
+      sim(i, k) = 0.3 * std::sin((1.0 + k) * t(i));
+      meas(i, k) = sim(i, k) + noise(rng);
+    }
+  const Eigen::VectorXd sigma = Eigen::VectorXd::Constant(d.nq, 0.003);
+  const fit::UnexplainedResidual quiet = fit::analyse_residual(d, t, meas, sim, p, sigma);
+  EXPECT_FALSE(quiet.above_floor) << quiet.statement;
+  for (const auto& c : quiet.coordinates) EXPECT_NEAR(c.ratio, 1.0, 0.1) << c.name;
+  // u2 moves as 0.3 sin(3t) and its measured angle carries an error 0.1 qdot = 0.09 cos(3t):
+  // far above the floor and along qdot, not q.
+  Eigen::MatrixXd meas2 = meas;
+  for (int i = 0; i < n; ++i) {
+    sim(i, 2) = 0.3 * std::sin(3.0 * t(i));
+    meas2(i, 2) = sim(i, 2) + 0.1 * 0.9 * std::cos(3.0 * t(i)) + noise(rng);
+  }
+  const fit::UnexplainedResidual loud = fit::analyse_residual(d, t, meas2, sim, p, sigma);
+  ASSERT_TRUE(loud.above_floor);
+  const auto& c = loud.coordinates.at(2);
+  EXPECT_GT(c.ratio, 10.0);
+  EXPECT_GT(std::abs(c.corr_qdot), 0.95);
+  // The measured angle holds the error itself (0.09 of its 0.31 amplitude): r(q) ~ 0.29.
+  EXPECT_LT(std::abs(c.corr_q), 0.4);
+  EXPECT_GT(c.band_power.at(0) + c.band_power.at(1), 0.95);  // 0.48 Hz
+  EXPECT_NE(loud.statement.find("u2"), std::string::npos) << loud.statement;
+  EXPECT_NE(loud.statement.find("qdot"), std::string::npos) << loud.statement;
+  EXPECT_EQ(loud.statement.find("u1:"), std::string::npos) << loud.statement;
+}
+
+TEST(LoopFolds, PartitionTheSamplesIntoAlternatingBlocks) {
+  const auto folds = fit::detail::make_folds(1000, 4);
+  ASSERT_EQ(folds.size(), 2u);
+  for (std::size_t i = 0; i < 1000; ++i) {
+    EXPECT_NE(folds[0].held_rows[i], folds[1].held_rows[i]) << i;  // each sample held out once
+    EXPECT_NE(folds[0].held_rows[i], folds[0].fit_rows[i]) << i;
+    EXPECT_EQ(folds[0].held_rows[i], (i / 250) % 2 == 0) << i;
+  }
+}
+
+TEST(LoopCandidates, EveryEffectInEveryAllowedScopeOnceAndNothingAlreadyHeld) {
+  const ArmDescription d = build_arm(softrne_test::two_joint_spec());
+  const std::vector<AnyEffect> c = fit::enumerate_candidates(d);
+  std::set<std::string> labels, names;
+  for (const AnyEffect& e : c) {
+    EXPECT_TRUE(labels.insert(fit::candidate_label(e, d)).second) << fit::candidate_label(e, d);
+    names.insert(effect_name(e));
+    const auto scopes = effect_scopes(e);
+    EXPECT_NE(std::find(scopes.begin(), scopes.end(), effect_base(e).scope), scopes.end());
+    for (Eigen::Index k = 0; k < effect_base(e).params.size(); ++k)
+      EXPECT_EQ(effect_base(e).params(k), effect_param_bounds(e, static_cast<int>(k), d.segment_mass()).neutral);
+  }
+  EXPECT_EQ(names.size(), effect_names().size());  // every effect applies to a CC arm
+  // Holding stiffening on joint2 removes exactly the stiffening candidates that touch joint2.
+  ArmDescription held = d;
+  add_effect(held, make_effect_at_neutral("stiffening", d, Scope::PerJoint, {1}));
+  int before = 0, after = 0;
+  for (const AnyEffect& e : c) before += effect_name(e) == "stiffening";
+  for (const AnyEffect& e : fit::enumerate_candidates(held)) {
+    if (effect_name(e) != "stiffening") continue;
+    ++after;
+    for (int j : effect_base(e).joints) EXPECT_NE(j, 1);
+  }
+  EXPECT_GT(before, after);
+  EXPECT_GT(after, 0);
+}
+
+TEST(LoopScreen, PredictsTheExactGainOfAnOffsetAndNoneForAnAbsentEffect) {
+  // Data: the declared model plus an angle offset of 0.02 rad on u2 only, without noise, so the
+  // truth is in the model class and a measurement offset is exactly linear in its parameter:
+  // the Gauss-Newton step recovers it and the held-out residual vanishes (gain 1).
+  const ArmDescription declared = build_arm(softrne_test::two_joint_spec());
+  AnyEffect off = make_effect_at_neutral("angle_offset", declared, Scope::PerCoordinate, {1});
+  effect_base(off).params << 0.02, 0.0;
+  ArmDescription truth = declared;
+  add_effect(truth, off);
+  const io::Dataset data = softrne_test::synthetic_dataset(truth, 4.0, 1.0, 7, 0.0, 0.0);
+  const auto folds = fit::detail::make_folds(data.t.size(), 4);
+  sim::ArmSimulationOptions so = fit::ArmFitOptions::default_simulation();
+  so.cvode.rtol = 1e-9;
+  so.cvode.atol = 1e-10;
+  const Eigen::MatrixXd y0 = fit::detail::simulated_angles(declared, data, so);
+  ASSERT_GT(y0.size(), 0);
+  const std::vector<fit::Candidate> cands =
+      fit::expand_secondary_kinds(fit::enumerate_candidates(declared), declared, y0, data, so, 2);
+  const auto screen = fit::screen_fold(cands, declared, y0, data, folds[0].fit_rows, folds[0].held_rows, so, 2);
+  int offset_joint2 = -1, stiffening = -1;
+  for (std::size_t i = 0; i < cands.size(); ++i) {
+    const auto& b = effect_base(cands[i].effect);
+    if (effect_name(cands[i].effect) == "angle_offset" && b.joints == std::vector<int>{1}) offset_joint2 = static_cast<int>(i);
+    if (effect_name(cands[i].effect) == "stiffening" && b.scope == Scope::Shared) stiffening = static_cast<int>(i);
+  }
+  ASSERT_GE(offset_joint2, 0);
+  ASSERT_GE(stiffening, 0);
+  EXPECT_GT(screen[static_cast<std::size_t>(offset_joint2)].predicted_gain, 0.97);
+  EXPECT_NEAR(screen[static_cast<std::size_t>(offset_joint2)].start(0), 0.02, 1e-3);
+  EXPECT_NEAR(screen[static_cast<std::size_t>(offset_joint2)].start(1), 0.0, 1e-3);
+  // The best candidate is that one; stiffening can explain at most a little of an offset.
+  for (std::size_t i = 0; i < cands.size(); ++i)
+    EXPECT_LE(screen[i].predicted_gain, screen[static_cast<std::size_t>(offset_joint2)].predicted_gain + 1e-9)
+        << cands[i].label;
+  EXPECT_LT(screen[static_cast<std::size_t>(stiffening)].predicted_gain, 0.5);
+}
+
+}  // namespace
