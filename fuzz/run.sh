@@ -5,7 +5,8 @@
 #
 # Environment: FUZZ_BUILD_DIR (default build-fuzz, relative to the repository root),
 #   CXX (default clang++), JOBS (default 2), FUZZ_WORKERS (parallel jobs per target,
-#   default 1), FUZZ_MAX_LEN (default 16384 bytes).
+#   default 1), FUZZ_MAX_LEN (default 16384 bytes), FUZZ_PARALLEL (1: all targets at the
+#   same time, one core each; default 1 when JOBS >= 2).
 # Each target starts from its seed corpus fuzz/corpus/<name>/ plus a working corpus in
 # <build>/corpus/<name>/ (new inputs go there, never into the source tree), with
 # -max_total_time=SECONDS -rss_limit_mb=2048 -timeout=10. Crashes, timeouts and
@@ -41,8 +42,13 @@ cmake -S "$root/fuzz" -B "$build_dir" "${gen[@]}" -DCMAKE_CXX_COMPILER="$cxx" >/
 cmake --build "$build_dir" -j "$jobs" --target "${targets[@]}"
 
 mkdir -p "$root/fuzz/regressions"
-status=0
-for t in "${targets[@]}"; do
+# One target per core: with FUZZ_PARALLEL (default: JOBS >= 2) the targets run at the same
+# time, each its full SECONDS on its own core, so the wall time is SECONDS instead of
+# SECONDS x targets; their reports are printed in order when all have finished.
+parallel=${FUZZ_PARALLEL:-$((jobs >= 2 ? 1 : 0))}
+
+fuzz_one() {  # target; prints the report, returns 1 on a finding or error
+  local t=$1 name exe work artifacts log dict par start rc elapsed execs cov found f base kind sha dest
   name=${t#fuzz_}
   exe=$build_dir/$t
   work=$build_dir/corpus/$name
@@ -77,9 +83,28 @@ for t in "${targets[@]}"; do
     found=1
   done
   if [[ $rc -ne 0 || $found -ne 0 ]]; then
-    status=1
     echo "   finding or error: see $log" >&2
     grep -m20 -E 'ERROR|SUMMARY|runtime error|terminate|what\(\)' "$log" >&2 || true
+    return 1
   fi
-done
+  return 0
+}
+
+status=0
+if [[ $parallel -eq 1 && ${#targets[@]} -gt 1 ]]; then
+  echo "== ${#targets[@]} targets in parallel (FUZZ_PARALLEL=1)"
+  pids=()
+  for t in "${targets[@]}"; do
+    fuzz_one "$t" >"$build_dir/$t.report" 2>&1 &
+    pids+=($!)
+  done
+  for i in "${!targets[@]}"; do
+    wait "${pids[i]}" || status=1
+    cat "$build_dir/${targets[i]}.report"
+  done
+else
+  for t in "${targets[@]}"; do
+    fuzz_one "$t" || status=1
+  done
+fi
 exit $status
