@@ -62,8 +62,10 @@ def effect_table(make_case):
     return rows
 
 
-def plan_cases(n, seed, pool):
+def plan_cases(n, seed, pool, controls_only=False):
     """Deterministic list of (case seed, [(effect, scope), ...])."""
+    if controls_only:  # effect-free arms only: the false-positive rate of the selection rule
+        return [(seed + i, []) for i in range(n)]
     rng = random.Random(seed)
     names = sorted({e for e, _ in pool})
     scopes = {e: sorted(s for x, s in pool if x == e) for e in names}
@@ -342,6 +344,8 @@ def main():
                     help="keep effects/scopes this build does not accept in the pool (their cases fail to generate)")
     ap.add_argument("--out", help="markdown output [WORK/score.md]; JSON next to it")
     ap.add_argument("--timeout", type=float, default=0, help="seconds per loop run, 0 = none [0]")
+    ap.add_argument("--controls-only", action="store_true",
+                    help="effect-free cases only (calibrates the false-positive rate)")
     ap.add_argument("--rescore", action="store_true",
                     help="do not run anything: score the cases already in WORK again (e.g. after a scoring change)")
     ap.add_argument("--loop-arg", action="append", default=[], help="extra argument for softrne-loop (repeatable)")
@@ -372,7 +376,7 @@ def main():
         die("the effect pool is empty (see --only, --all-effects)")
     args.work = os.path.abspath(args.work)
     os.makedirs(args.work, exist_ok=True)
-    plan = plan_cases(args.cases, args.seed, pool)
+    plan = plan_cases(args.cases, args.seed, pool, args.controls_only)
     results = [None] * len(plan)
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as ex:
         futs = {ex.submit(run_case, args, s, e, tools): i for i, (s, e) in enumerate(plan)}

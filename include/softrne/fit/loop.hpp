@@ -52,7 +52,7 @@ inline constexpr const char* kCalibratedFalsePositiveRate = "not yet measured";
 struct LoopOptions {
   ArmFitOptions fit{};
   int max_effects = 4;
-  int candidates_to_confirm = 3;  ///< best-screened candidates refitted per round
+  int candidates_to_confirm = 4;  ///< best-screened candidates refitted per round
   /// Relative drop of the held-out error a candidate must reach in every fold. Its
   /// false-positive rate on effect-free data is measured in docs/closing-the-loop.md.
   double min_gain = 0.05;
@@ -250,9 +250,17 @@ inline LoopResult run_loop(const ArmDescription& declared, const io::Dataset& tr
 
     std::vector<std::vector<ArmFitResult>> fold_fits(scores.size());
     std::vector<int> passing;
-    for (std::size_t r = 0; r < scores.size() && static_cast<int>(r) < opt.candidates_to_confirm; ++r) {
+    // Refit the best-screened, at most two scopes per effect: models that the screen cannot
+    // tell apart (a Dahl element with a small yield angle is Coulomb friction) must both be
+    // refitted so that the held-out error, and parsimony, choose between them.
+    std::vector<std::string> confirmed_names;
+    int refitted = 0;
+    for (std::size_t r = 0; r < scores.size() && refitted < opt.candidates_to_confirm; ++r) {
       CandidateScore& s = scores[r];
       if (worst(score_cand[r]) < opt.min_predicted_gain) break;  // ordered: the rest predict less
+      if (std::count(confirmed_names.begin(), confirmed_names.end(), s.name) >= 2) continue;
+      confirmed_names.push_back(s.name);
+      ++refitted;
       const Candidate& cand = cands[score_cand[r]];
       std::vector<ArmFitResult> fits;
       s.confirmed = true;
