@@ -12,7 +12,9 @@
 ///     stage included), so nothing a fold's decision uses has seen its held-out blocks.
 ///  3. Screen (candidates.hpp): every effect, in every scope it allows, gets a linearised
 ///     held-out gain per fold from sensitivities of the fold's simulated trajectory.
-///  4. Confirmation: the best `candidates_to_confirm` candidates are refitted in each fold (the
+///  4. Confirmation: each fold's base model first gets the same local refit a candidate gets
+///     (so that no candidate earns credit for K, D iterations the base had not had); then the
+///     best `candidates_to_confirm` candidates are refitted in each fold (the
 ///     effect with every stiffness, damping and effect already held, by simulation error on the
 ///     fold's training blocks, from the fold's base model and the fold's own screening step),
 ///     and the measured held-out RMS error is compared with the fold's base model.
@@ -211,6 +213,23 @@ inline LoopResult run_loop(const ArmDescription& declared, const io::Dataset& tr
     if (!folds_ok) {
       log("a fold's base model fails to simulate: no effect can be judged");
       break;
+    }
+    // A fair comparator: each fold's base model gets the same local refit a candidate gets
+    // (from where it stands, on its own training blocks), so a candidate cannot earn credit
+    // for iterations on K and D that the base model simply had not had.
+    for (auto& f : folds) {
+      ArmFitOptions o = refit;
+      o.sample_mask = f.fit_rows;
+      const ArmFitResult polished = fit_arm(f.model, train, o);
+      out.simulations += polished.simulations;
+      const Eigen::MatrixXd y = detail::simulated_angles(polished.fitted, train, sim_opt);
+      const double held = y.size() ? detail::masked_rms(y, train.angles, f.held_rows)
+                                   : std::numeric_limits<double>::infinity();
+      if (y.size() && std::isfinite(held)) {
+        f.model = polished.fitted;
+        f.angles = y;
+        f.held_rms = held;
+      }
     }
     // Candidates on the current structure (the folds' models share it).
     const std::vector<AnyEffect> raw = enumerate_candidates(current);
