@@ -312,8 +312,9 @@ inline std::vector<FoldScreen> screen_fold(const std::vector<Candidate>& cands,
       else S.col(j) = sens[t];
     }
     if (!ok || np == 0 || !(ref > 0)) continue;
+    const Eigen::MatrixXd ST = rows_of(S, T), SH = rows_of(S, H);
     Eigen::MatrixXd XT(static_cast<Eigen::Index>(T.size()), KT.cols() + np);
-    XT << KT, rows_of(S, T);
+    XT << KT, ST;
     const Eigen::VectorXd coef = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(XT).solve(eT);
     // Clamp the step to the effect's bounds, then re-solve K, D for the clamped effect.
     FoldScreen fs;
@@ -326,7 +327,6 @@ inline std::vector<FoldScreen> screen_fold(const std::vector<Candidate>& cands,
       dth(j) = v - fs.start(p);
       fs.start(p) = v;
     }
-    const Eigen::MatrixXd ST = rows_of(S, T), SH = rows_of(S, H);
     const Eigen::VectorXd a = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(KT).solve(eT - ST * dth);
     fs.predicted_gain = 1.0 - rms(eH - KH * a - SH * dth) / ref;
     out[c] = fs;

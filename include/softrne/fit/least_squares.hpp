@@ -34,6 +34,8 @@
 #include <Eigen/SVD>
 #include <nlopt.h>
 
+#include "softrne/fit/parallel_for.hpp"
+
 #include <softrne/fit/parameters.hpp>
 
 namespace softrne::fit {
@@ -214,34 +216,8 @@ class Runner {
   }
 
   void run(int n, const std::function<void(int task, Evaluator& ev)>& task) {
-    const int workers = std::min<int>(static_cast<int>(evaluators_.size()), n);
-    if (workers <= 1) {
-      for (int k = 0; k < n; ++k) task(k, main());
-      return;
-    }
-    std::atomic<int> next{0};
-    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(workers));
-    auto work = [&](int w) {
-      try {
-        for (int k = next++; k < n; k = next++) task(k, *evaluators_[w]);
-      } catch (...) {
-        errors[w] = std::current_exception();
-        next = n;  // stop handing out tasks
-      }
-    };
-    std::vector<std::thread> pool;
-    pool.reserve(static_cast<std::size_t>(workers - 1));
-    for (int w = 1; w < workers; ++w) {
-      try {
-        pool.emplace_back(work, w);
-      } catch (...) {
-        break;  // could not start a thread: the others take its share
-      }
-    }
-    work(0);
-    for (std::thread& th : pool) th.join();
-    for (const std::exception_ptr& e : errors)
-      if (e) std::rethrow_exception(e);
+    parallel_for_workers(n, static_cast<int>(evaluators_.size()),
+                         [&](int k, int w) { task(k, *evaluators_[static_cast<std::size_t>(w)]); });
   }
 
  private:
