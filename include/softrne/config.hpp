@@ -25,3 +25,46 @@
   do {                            \
   } while (false)
 #endif
+
+/// \brief Header-only or compiled: the heavy entry points of the arm layer (model/, sim/:
+/// SOFTRNE_SIM_*) and of fit/ (SOFTRNE_FIT_*).
+///
+/// softrne is header-only: by default these functions are `inline` and compiled in every
+/// translation unit that calls them. Each such unit then instantiates the simulator, the
+/// AutoDiff Jacobian, the fitter and the loop anew (one to three minutes of compiler time
+/// per unit at -O3), which is what a project with many of them pays for (ours: the tests and
+/// tools). A target that links softrne's compiled libraries (CMake `softrne::sim_compiled`,
+/// `softrne::fit_compiled`, which define SOFTRNE_USE_COMPILED for it) sees declarations
+/// only, and src/sim.cpp and src/fit.cpp (which define SOFTRNE_COMPILING_SIM /
+/// SOFTRNE_COMPILING_FIT) hold the one definition. The same idea as Pinocchio's explicit
+/// template instantiation library; the code is the same text in both modes.
+///
+/// Usage at a definition:
+///
+///     SOFTRNE_FIT_INLINE FitResult fit_arm(...)
+///     #if SOFTRNE_FIT_BODIES
+///     { ...body... }
+///     #else
+///     ;
+///     #endif
+#if defined(SOFTRNE_COMPILING_SIM)
+#define SOFTRNE_SIM_INLINE
+#define SOFTRNE_SIM_BODIES 1
+#elif defined(SOFTRNE_USE_COMPILED)
+#define SOFTRNE_SIM_INLINE
+#define SOFTRNE_SIM_BODIES 0
+#else
+#define SOFTRNE_SIM_INLINE inline
+#define SOFTRNE_SIM_BODIES 1
+#endif
+
+#if defined(SOFTRNE_COMPILING_FIT)
+#define SOFTRNE_FIT_INLINE
+#define SOFTRNE_FIT_BODIES 1
+#elif defined(SOFTRNE_USE_COMPILED)
+#define SOFTRNE_FIT_INLINE
+#define SOFTRNE_FIT_BODIES 0
+#else
+#define SOFTRNE_FIT_INLINE inline
+#define SOFTRNE_FIT_BODIES 1
+#endif

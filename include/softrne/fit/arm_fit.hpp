@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/config.hpp"
 #include "softrne/fit/least_squares.hpp"
 #include "softrne/fit/parameters.hpp"
 #include "softrne/io/csv.hpp"
@@ -75,8 +76,10 @@ struct ParamSlot {
   int k;      // axis or effect parameter index
 };
 
-inline std::vector<ParamSlot> make_slots(const ArmDescription& d, const ArmFitOptions& o,
-                                         ParameterSet& ps) {
+SOFTRNE_FIT_INLINE std::vector<ParamSlot> make_slots(const ArmDescription& d, const ArmFitOptions& o,
+                                                     ParameterSet& ps)
+#if SOFTRNE_FIT_BODIES
+{
   std::vector<ParamSlot> slots;
   const double range = o.stiffness_range;
   auto bounded = [&](double x0, double fallback) {
@@ -119,9 +122,14 @@ inline std::vector<ParamSlot> make_slots(const ArmDescription& d, const ArmFitOp
   }
   return slots;
 }
+#else
+;
+#endif
 
-inline void apply(const std::vector<ParamSlot>& slots, const Eigen::VectorXd& x,
-                  const ArmDescription& start, ArmDescription& d) {
+SOFTRNE_FIT_INLINE void apply(const std::vector<ParamSlot>& slots, const Eigen::VectorXd& x,
+                              const ArmDescription& start, ArmDescription& d)
+#if SOFTRNE_FIT_BODIES
+{
   for (std::size_t i = 0; i < slots.size(); ++i) {
     const ParamSlot& s = slots[i];
     const double v = x(static_cast<Eigen::Index>(i));
@@ -136,16 +144,24 @@ inline void apply(const std::vector<ParamSlot>& slots, const Eigen::VectorXd& x,
     }
   }
 }
+#else
+;
+#endif
 
 }  // namespace detail
 
 /// \brief Simulates the arm on a data set (from rest at the first measured row).
-inline sim::ArmSimulation simulate_dataset(const ArmDescription& d, const io::Dataset& data,
-                                           const sim::ArmSimulationOptions& opt) {
+SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d, const io::Dataset& data,
+                                                       const sim::ArmSimulationOptions& opt)
+#if SOFTRNE_FIT_BODIES
+{
   const Eigen::VectorXd q0 =
       data.has_angles ? Eigen::VectorXd(data.angles.row(0).transpose()) : Eigen::VectorXd::Zero(d.nq);
   return sim::simulate_arm(d, data.t, data.pressures, q0, opt);
 }
+#else
+;
+#endif
 
 /// \brief Checks that a data set can support a fit; throws std::invalid_argument naming the
 /// data set and what is missing.
@@ -166,8 +182,10 @@ inline void check_fit_data(const ArmDescription& d, const io::Dataset& data) {
 /// \brief Fits the free parameters of `start` to the measured angles of `data`, minimising the
 /// simulation error (the model is simulated from the first sample with the recorded pressures,
 /// not one step ahead). Deterministic for a given optimiser seed.
-inline ArmFitResult fit_arm(const ArmDescription& start, const io::Dataset& data,
-                            const ArmFitOptions& opt = {}) {
+SOFTRNE_FIT_INLINE ArmFitResult fit_arm(const ArmDescription& start, const io::Dataset& data,
+                                        const ArmFitOptions& opt = {})
+#if SOFTRNE_FIT_BODIES
+{
   check_fit_data(start, data);
   const auto t0 = std::chrono::steady_clock::now();
   ArmFitResult out;
@@ -209,5 +227,8 @@ inline ArmFitResult fit_arm(const ArmDescription& start, const io::Dataset& data
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
+#else
+;
+#endif
 
 }  // namespace softrne::fit

@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 #include <Eigen/QR>
 
+#include "softrne/config.hpp"
 #include "softrne/fit/arm_fit.hpp"
 #include "softrne/fit/parallel_for.hpp"
 
@@ -80,12 +81,17 @@ inline ArmDescription with_effect(const ArmDescription& d, const AnyEffect& e) {
 }
 
 /// Simulated angles (N x nq) of `d` on `data`; empty on failure.
-inline Eigen::MatrixXd simulated_angles(const ArmDescription& d, const io::Dataset& data,
-                                        const sim::ArmSimulationOptions& opt) {
+SOFTRNE_FIT_INLINE Eigen::MatrixXd simulated_angles(const ArmDescription& d, const io::Dataset& data,
+                                                    const sim::ArmSimulationOptions& opt)
+#if SOFTRNE_FIT_BODIES
+{
   const sim::ArmSimulation s = simulate_dataset(d, data, opt);
   if (!s.ok() || s.angles.rows() != data.t.size() || !s.angles.allFinite()) return {};
   return s.angles;
 }
+#else
+;
+#endif
 
 /// Screening step of a parameter from its neutral value: toward the interior of its bounds,
 /// 2 % of the range (linear kinds) or a factor (upper/lower)^0.1 (log-scale kinds).
@@ -101,7 +107,9 @@ inline double screening_step(const EffectBounds& b) {
 /// \brief Every effect in every allowed scope on `current`'s joints, at its neutral value,
 /// leaving out what `current` already holds. Secondary kinds are not yet resolved (see
 /// expand_secondary_kinds).
-inline std::vector<AnyEffect> enumerate_candidates(const ArmDescription& current) {
+SOFTRNE_FIT_INLINE std::vector<AnyEffect> enumerate_candidates(const ArmDescription& current)
+#if SOFTRNE_FIT_BODIES
+{
   std::vector<AnyEffect> out;
   for (const std::string& name : effect_names()) {
     AnyEffect probe;
@@ -130,17 +138,22 @@ inline std::vector<AnyEffect> enumerate_candidates(const ArmDescription& current
   }
   return out;
 }
+#else
+;
+#endif
 
 /// \brief Resolves secondary kinds: a kind whose parameters do not move the simulation of
 /// `base` + effect (all at neutral) is screened at three fixed values; the others are screened
 /// by sensitivity. Returns one Candidate per variant. Costs one simulation per kind of a
 /// multi-kind effect.
-inline std::vector<Candidate> expand_secondary_kinds(const std::vector<AnyEffect>& effects,
-                                                     const ArmDescription& base,
-                                                     const Eigen::MatrixXd& base_angles,
-                                                     const io::Dataset& data,
-                                                     const sim::ArmSimulationOptions& sim_opt,
-                                                     int threads, int* simulations = nullptr) {
+SOFTRNE_FIT_INLINE std::vector<Candidate> expand_secondary_kinds(const std::vector<AnyEffect>& effects,
+                                                                 const ArmDescription& base,
+                                                                 const Eigen::MatrixXd& base_angles,
+                                                                 const io::Dataset& data,
+                                                                 const sim::ArmSimulationOptions& sim_opt,
+                                                                 int threads, int* simulations = nullptr)
+#if SOFTRNE_FIT_BODIES
+{
   const double mass = base.segment_mass();
   // Which (effect, kind) pairs need a probe simulation.
   struct Probe {
@@ -212,13 +225,18 @@ inline std::vector<Candidate> expand_secondary_kinds(const std::vector<AnyEffect
   }
   return out;
 }
+#else
+;
+#endif
 
 /// \brief Sensitivities of the simulated angles (flattened row-major, N*nq) to every
 /// stiffness and damping of `base` (relative step 1e-3): the nuisance columns of the screen.
-inline Eigen::MatrixXd nuisance_sensitivities(const ArmDescription& base, const Eigen::MatrixXd& y0,
-                                              const io::Dataset& data,
-                                              const sim::ArmSimulationOptions& sim_opt, int threads,
-                                              int* simulations = nullptr) {
+SOFTRNE_FIT_INLINE Eigen::MatrixXd nuisance_sensitivities(const ArmDescription& base, const Eigen::MatrixXd& y0,
+                                                          const io::Dataset& data,
+                                                          const sim::ArmSimulationOptions& sim_opt, int threads,
+                                                          int* simulations = nullptr)
+#if SOFTRNE_FIT_BODIES
+{
   struct Col {
     int joint, k;
     bool damping;
@@ -247,15 +265,20 @@ inline Eigen::MatrixXd nuisance_sensitivities(const ArmDescription& base, const 
   });
   return S;
 }
+#else
+;
+#endif
 
 /// \brief Screens every candidate in one fold (see the file comment). `base` is the fold's
 /// model, `y0` its simulated angles, `fit_rows` / `held_rows` the fold's sample masks.
-inline std::vector<FoldScreen> screen_fold(const std::vector<Candidate>& cands,
-                                           const ArmDescription& base, const Eigen::MatrixXd& y0,
-                                           const io::Dataset& data, const std::vector<bool>& fit_rows,
-                                           const std::vector<bool>& held_rows,
-                                           const sim::ArmSimulationOptions& sim_opt, int threads,
-                                           int* simulations = nullptr) {
+SOFTRNE_FIT_INLINE std::vector<FoldScreen> screen_fold(const std::vector<Candidate>& cands,
+                                                       const ArmDescription& base, const Eigen::MatrixXd& y0,
+                                                       const io::Dataset& data, const std::vector<bool>& fit_rows,
+                                                       const std::vector<bool>& held_rows,
+                                                       const sim::ArmSimulationOptions& sim_opt, int threads,
+                                                       int* simulations = nullptr)
+#if SOFTRNE_FIT_BODIES
+{
   const Eigen::Index N = y0.rows(), nq = y0.cols();
   const double mass = base.segment_mass();
   const Eigen::MatrixXd SKD = nuisance_sensitivities(base, y0, data, sim_opt, threads, simulations);
@@ -333,5 +356,8 @@ inline std::vector<FoldScreen> screen_fold(const std::vector<Candidate>& cands,
   }
   return out;
 }
+#else
+;
+#endif
 
 }  // namespace softrne::fit

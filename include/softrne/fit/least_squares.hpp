@@ -34,6 +34,7 @@
 #include <Eigen/SVD>
 #include <nlopt.h>
 
+#include "softrne/config.hpp"
 #include "softrne/fit/parallel_for.hpp"
 
 #include <softrne/fit/parameters.hpp>
@@ -231,9 +232,11 @@ inline double half_squared_norm(const Eigen::VectorXd& r) {
 /// Forward (or central) differences of r(u) in normalised coordinates,
 /// stepping inside [0,1] and falling back to the other side when an
 /// evaluation fails. Columns that cannot be formed are zero, `column_ok` false.
-inline void jacobian_normalised(Runner& runner, const Eigen::VectorXd& u, const Eigen::VectorXd& r,
-                                double h, bool central, Eigen::MatrixXd& J,
-                                std::vector<char>& column_ok) {
+SOFTRNE_FIT_INLINE void jacobian_normalised(Runner& runner, const Eigen::VectorXd& u, const Eigen::VectorXd& r,
+                                            double h, bool central, Eigen::MatrixXd& J,
+                                            std::vector<char>& column_ok)
+#if SOFTRNE_FIT_BODIES
+{
   const int p = static_cast<int>(u.size());
   J.resize(r.size(), p);
   column_ok.assign(static_cast<std::size_t>(p), 0);
@@ -274,6 +277,9 @@ inline void jacobian_normalised(Runner& runner, const Eigen::VectorXd& u, const 
     column_ok[k] = ok ? 1 : 0;
   });
 }
+#else
+;
+#endif
 
 struct LmSettings {
   int max_evals = 400;
@@ -300,8 +306,10 @@ struct LmOutcome {
 /// (variables not held at a bound by the gradient), \f$D\f$ the running
 /// maximum of diag(\f$J^TJ\f$) (Moré 1978), projected onto the box. Gain-ratio
 /// acceptance and the \f$\lambda\f$ update of Nielsen (1999).
-inline LmOutcome levenberg_marquardt(Runner& runner, const Eigen::VectorXd& u0,
-                                     const LmSettings& s) {
+SOFTRNE_FIT_INLINE LmOutcome levenberg_marquardt(Runner& runner, const Eigen::VectorXd& u0,
+                                                 const LmSettings& s)
+#if SOFTRNE_FIT_BODIES
+{
   LmOutcome out;
   const int p = static_cast<int>(u0.size());
   const int start = runner.evaluations();
@@ -449,6 +457,9 @@ inline LmOutcome levenberg_marquardt(Runner& runner, const Eigen::VectorXd& u0,
   out.cost = cost;
   return out;
 }
+#else
+;
+#endif
 
 /// Radical inverse of `index` in `base` (van der Corput).
 inline double radical_inverse(std::uint64_t index, std::uint64_t base) {
@@ -524,11 +535,13 @@ struct NloptObjective {
 
 /// Runs one NLopt algorithm on the cost in [0,1]^p from `u0`; returns the
 /// best valid point it saw (or u0) and appends a summary to `msg`.
-inline Eigen::VectorXd run_nlopt(nlopt_algorithm algorithm, Runner& runner,
-                                 const Eigen::VectorXd& u0, int max_evals, double xtol_rel,
-                                 double ftol_rel, unsigned seed, const Deadline& deadline,
-                                 const std::function<void(double)>& report, double& best_cost,
-                                 std::ostringstream& msg) {
+SOFTRNE_FIT_INLINE Eigen::VectorXd run_nlopt(nlopt_algorithm algorithm, Runner& runner,
+                                             const Eigen::VectorXd& u0, int max_evals, double xtol_rel,
+                                             double ftol_rel, unsigned seed, const Deadline& deadline,
+                                             const std::function<void(double)>& report, double& best_cost,
+                                             std::ostringstream& msg)
+#if SOFTRNE_FIT_BODIES
+{
   const unsigned p = static_cast<unsigned>(u0.size());
   NloptObjective objective;
   objective.evaluator = &runner.main();
@@ -558,13 +571,18 @@ inline Eigen::VectorXd run_nlopt(nlopt_algorithm algorithm, Runner& runner,
   msg << ", no valid point";
   return u0;
 }
+#else
+;
+#endif
 
 /// Seeded multistart: screen `global_evals/2` points (the initial guess and
 /// a shifted Halton set), then refine the best distinct ones with short LM
 /// runs in parallel; returns the best refined point.
-inline Eigen::VectorXd multistart(Runner& runner, const Eigen::VectorXd& u0, const FitOptions& opt,
-                                  double fd_step, const Deadline& deadline, double& best_cost,
-                                  std::ostringstream& msg) {
+SOFTRNE_FIT_INLINE Eigen::VectorXd multistart(Runner& runner, const Eigen::VectorXd& u0, const FitOptions& opt,
+                                              double fd_step, const Deadline& deadline, double& best_cost,
+                                              std::ostringstream& msg)
+#if SOFTRNE_FIT_BODIES
+{
   const int p = static_cast<int>(u0.size());
   const int n_screen = std::max(1, opt.global_evals / 2);
   std::vector<Eigen::VectorXd> points = shifted_halton(p, n_screen - 1, opt.seed);
@@ -637,10 +655,15 @@ inline Eigen::VectorXd multistart(Runner& runner, const Eigen::VectorXd& u0, con
   msg << ", best cost " << best_cost;
   return refined[best].u;
 }
+#else
+;
+#endif
 
 /// Fills the identifiability fields of `res` at `res.params` (r = residual there).
-inline void identifiability(const ParameterSet& ps, Runner& runner, const Eigen::VectorXd& r,
-                            const IdentifiabilityOptions& io, FitResult& res) {
+SOFTRNE_FIT_INLINE void identifiability(const ParameterSet& ps, Runner& runner, const Eigen::VectorXd& r,
+                                        const IdentifiabilityOptions& io, FitResult& res)
+#if SOFTRNE_FIT_BODIES
+{
   const int p = ps.size();
   const Eigen::Index m = r.size();
   const Eigen::VectorXd x = res.params;
@@ -783,9 +806,14 @@ inline void identifiability(const ParameterSet& ps, Runner& runner, const Eigen:
             << res.correlation(i, j) << std::noshowpos << ")\n";
   res.identifiability_report = rep.str();
 }
+#else
+;
+#endif
 
-inline FitResult fit_impl(const ParameterSet& ps, int m, std::vector<ResidualFn> functors,
-                          const FitOptions& opt, const std::string& note) {
+SOFTRNE_FIT_INLINE FitResult fit_impl(const ParameterSet& ps, int m, std::vector<ResidualFn> functors,
+                                      const FitOptions& opt, const std::string& note)
+#if SOFTRNE_FIT_BODIES
+{
   const int p = ps.size();
   if (p < 1) throw std::invalid_argument("softrne::fit::fit_least_squares: no parameters");
   if (m < 1) throw std::invalid_argument("softrne::fit::fit_least_squares: residual_size < 1");
@@ -884,6 +912,9 @@ inline FitResult fit_impl(const ParameterSet& ps, int m, std::vector<ResidualFn>
   if (opt.progress && lm.valid) opt.progress(res.evaluations, res.cost);
   return res;
 }
+#else
+;
+#endif
 
 }  // namespace detail
 
@@ -895,31 +926,43 @@ inline FitResult fit_impl(const ParameterSet& ps, int m, std::vector<ResidualFn>
 /// calling thread only, so `opt.threads` is ignored here (see the
 /// ResidualFactory overload).
 /// \param residual_size the fixed length \f$m\f$ of the residual.
-inline FitResult fit_least_squares(const ParameterSet& params, int residual_size,
-                                   const ResidualFn& residual, const FitOptions& opt = {}) {
+SOFTRNE_FIT_INLINE FitResult fit_least_squares(const ParameterSet& params, int residual_size,
+                                               const ResidualFn& residual, const FitOptions& opt = {})
+#if SOFTRNE_FIT_BODIES
+{
   return detail::fit_impl(
       params, residual_size, {residual}, opt,
       opt.threads > 1 ? "threads > 1 ignored: pass a ResidualFactory to evaluate in parallel" : "");
 }
+#else
+;
+#endif
 
 /// \brief As above, evaluating independent candidates (multistart points and
 ///        starts, Jacobian columns) on `opt.threads` threads, each with its
 ///        own functor from `make_residual` (called `max(1, opt.threads)`
 ///        times, on the calling thread). The result equals the serial one
 ///        bit for bit when the functors are deterministic.
-inline FitResult fit_least_squares(const ParameterSet& params, int residual_size,
-                                   const ResidualFactory& make_residual,
-                                   const FitOptions& opt = {}) {
+SOFTRNE_FIT_INLINE FitResult fit_least_squares(const ParameterSet& params, int residual_size,
+                                               const ResidualFactory& make_residual,
+                                               const FitOptions& opt = {})
+#if SOFTRNE_FIT_BODIES
+{
   std::vector<ResidualFn> functors;
   for (int w = 0; w < std::max(1, opt.threads); ++w) functors.push_back(make_residual());
   return detail::fit_impl(params, residual_size, std::move(functors), opt, "");
 }
+#else
+;
+#endif
 
 /// \brief Identifiability analysis alone at `result.params` (e.g. at a
 ///        hand-picked point): fills cost, rms and the identifiability fields.
-inline void analyse_identifiability(const ParameterSet& params, int residual_size,
-                                    const ResidualFn& residual, FitResult& result,
-                                    const IdentifiabilityOptions& io = {}) {
+SOFTRNE_FIT_INLINE void analyse_identifiability(const ParameterSet& params, int residual_size,
+                                                const ResidualFn& residual, FitResult& result,
+                                                const IdentifiabilityOptions& io = {})
+#if SOFTRNE_FIT_BODIES
+{
   detail::Evaluator ev(params, residual_size, residual);
   detail::Runner runner({&ev});
   Eigen::VectorXd r;
@@ -931,5 +974,8 @@ inline void analyse_identifiability(const ParameterSet& params, int residual_siz
   result.rms = std::sqrt(2.0 * result.cost / residual_size);
   detail::identifiability(params, runner, r, io, result);
 }
+#else
+;
+#endif
 
 }  // namespace softrne::fit

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/config.hpp"
 #include "softrne/fit/noise_floor.hpp"
 #include "softrne/fit/savitzky_golay.hpp"
 #include "softrne/model/arm_model.hpp"
@@ -51,7 +52,9 @@ inline double pearson(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 
 /// Power fractions per band of a demeaned signal on a (near) uniform grid, by a direct DFT
 /// (O(N^2), N ~ 1e3..1e4 here).
-inline std::vector<double> band_fractions(const Eigen::VectorXd& t, const Eigen::VectorXd& e) {
+SOFTRNE_FIT_INLINE std::vector<double> band_fractions(const Eigen::VectorXd& t, const Eigen::VectorXd& e)
+#if SOFTRNE_FIT_BODIES
+{
   const auto edges = residual_band_edges();
   std::vector<double> p(edges.size() + 1, 0.0);
   const Eigen::Index n = e.size();
@@ -74,6 +77,9 @@ inline std::vector<double> band_fractions(const Eigen::VectorXd& t, const Eigen:
     for (double& v : p) v /= total;
   return p;
 }
+#else
+;
+#endif
 
 }  // namespace detail
 
@@ -84,11 +90,13 @@ inline std::vector<double> band_fractions(const Eigen::VectorXd& t, const Eigen:
 /// \param simulated simulated angles in measurement space (N x nq)
 /// \param pressures recorded pressures (N x inputs)
 /// \param sigma     sensor noise per coordinate (estimate_noise_sigma)
-inline UnexplainedResidual analyse_residual(const ArmDescription& desc, const Eigen::VectorXd& t,
-                                            const Eigen::MatrixXd& measured,
-                                            const Eigen::MatrixXd& simulated,
-                                            const Eigen::MatrixXd& pressures,
-                                            const Eigen::VectorXd& sigma, double threshold = 1.5) {
+SOFTRNE_FIT_INLINE UnexplainedResidual analyse_residual(const ArmDescription& desc, const Eigen::VectorXd& t,
+                                                        const Eigen::MatrixXd& measured,
+                                                        const Eigen::MatrixXd& simulated,
+                                                        const Eigen::MatrixXd& pressures,
+                                                        const Eigen::VectorXd& sigma, double threshold = 1.5)
+#if SOFTRNE_FIT_BODIES
+{
   UnexplainedResidual out;
   out.threshold = threshold;
   const Eigen::Index n = std::min(measured.rows(), simulated.rows());
@@ -148,5 +156,8 @@ inline UnexplainedResidual analyse_residual(const ArmDescription& desc, const Ei
                     "x of the sensor noise floor: nothing systematic is left to explain";
   return out;
 }
+#else
+;
+#endif
 
 }  // namespace softrne::fit

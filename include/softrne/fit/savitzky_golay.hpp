@@ -19,6 +19,8 @@
 #include <Eigen/Core>
 #include <Eigen/QR>
 
+#include "softrne/config.hpp"
+
 namespace softrne::fit {
 
 /// \brief Window and order of the smoothing differentiator.
@@ -37,8 +39,10 @@ struct SgOptions {
 /// \param order    polynomial order \f$p\f$, with `t_window.size() >= p+1`.
 /// \return a \f$3 \times w\f$ matrix `W`: `W.row(d).dot(y_window)` is the
 ///         d-th derivative. Rows above `order` are zero.
-inline Eigen::Matrix<double, 3, Eigen::Dynamic> savgol_weights(const Eigen::VectorXd& t_window,
-                                                               double t_eval, int order) {
+SOFTRNE_FIT_INLINE Eigen::Matrix<double, 3, Eigen::Dynamic> savgol_weights(const Eigen::VectorXd& t_window,
+                                                                           double t_eval, int order)
+#if SOFTRNE_FIT_BODIES
+{
   const Eigen::Index w = t_window.size();
   if (order < 0) throw std::invalid_argument("softrne::fit::savgol_weights: order < 0");
   if (w < order + 1)
@@ -69,6 +73,9 @@ inline Eigen::Matrix<double, 3, Eigen::Dynamic> savgol_weights(const Eigen::Vect
   if (order >= 2) W.row(2) = 2.0 * P.row(2) / (scale * scale);
   return W;
 }
+#else
+;
+#endif
 
 /// \brief Column-wise Savitzky-Golay smoothing and differentiation.
 ///
@@ -81,8 +88,10 @@ inline Eigen::Matrix<double, 3, Eigen::Dynamic> savgol_weights(const Eigen::Vect
 /// \param ddy second derivatives w.r.t. t (zero when `order < 2`).
 /// \throws std::invalid_argument on mismatched sizes, non-increasing t, or
 ///         fewer than `order + 1` samples.
-inline void savgol(const Eigen::VectorXd& t, const Eigen::MatrixXd& y, const SgOptions& opt,
-                   Eigen::MatrixXd& y_s, Eigen::MatrixXd& dy, Eigen::MatrixXd& ddy) {
+SOFTRNE_FIT_INLINE void savgol(const Eigen::VectorXd& t, const Eigen::MatrixXd& y, const SgOptions& opt,
+                               Eigen::MatrixXd& y_s, Eigen::MatrixXd& dy, Eigen::MatrixXd& ddy)
+#if SOFTRNE_FIT_BODIES
+{
   const Eigen::Index n = t.size();
   if (y.rows() != n) throw std::invalid_argument("softrne::fit::savgol: y.rows() != t.size()");
   if (opt.half_window < 0 || opt.order < 0)
@@ -108,5 +117,8 @@ inline void savgol(const Eigen::VectorXd& t, const Eigen::MatrixXd& y, const SgO
     ddy.row(i).noalias() = W.row(2) * block;
   }
 }
+#else
+;
+#endif
 
 }  // namespace softrne::fit

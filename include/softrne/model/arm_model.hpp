@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/config.hpp"
 #include "softrne/algorithms/forward_dynamics.hpp"
 #include "softrne/chain/dynamic_chain.hpp"
 #include "softrne/effects/effect_info.hpp"
@@ -176,7 +177,9 @@ inline std::vector<std::string> effect_param_names(const AnyEffect& e, const Arm
 
 /// \brief Appends an effect to the description and gives it its slice of the effect states.
 /// Throws std::invalid_argument if its parameter count does not match its scope and joints.
-inline void add_effect(ArmDescription& d, AnyEffect e) {
+SOFTRNE_SIM_INLINE void add_effect(ArmDescription& d, AnyEffect e)
+#if SOFTRNE_SIM_BODIES
+{
   const int np = effect_num_params(e, d.joints);
   if (effect_base(e).params.size() != np)
     throw std::invalid_argument("effect '" + effect_name(e) + "': " +
@@ -187,13 +190,18 @@ inline void add_effect(ArmDescription& d, AnyEffect e) {
   d.num_effect_states += std::visit([&](const auto& x) { return x.num_states(d.joints); }, e);
   d.effects.push_back(std::move(e));
 }
+#else
+;
+#endif
 
 /// \brief A candidate at its neutral values: effect `name` on `joints` (indices into the
 /// joint table; all joints it applies to when empty) with `scope`. Throws
 /// std::invalid_argument on an unknown name, a scope the effect does not allow, or a joint it
 /// does not apply to.
-inline AnyEffect make_effect_at_neutral(const std::string& name, const ArmDescription& d,
-                                        Scope scope, std::vector<int> joints = {}) {
+SOFTRNE_SIM_INLINE AnyEffect make_effect_at_neutral(const std::string& name, const ArmDescription& d,
+                                                    Scope scope, std::vector<int> joints = {})
+#if SOFTRNE_SIM_BODIES
+{
   AnyEffect e;
   if (!make_effect(name, e))
     throw std::invalid_argument("effect '" + name + "': unknown effect name");
@@ -218,13 +226,18 @@ inline AnyEffect make_effect_at_neutral(const std::string& name, const ArmDescri
   for (int k = 0; k < np; ++k) b.params(k) = effect_param_bounds(e, k, d.segment_mass()).neutral;
   return e;
 }
+#else
+;
+#endif
 
 namespace detail {
 
 /// \brief Reads an effect's parameters from a robot-file entry: the scope is the one whose
 /// names (formats.md section 4) are exactly the keys present. `where` names the entry.
-inline void read_effect_params(const io::EffectSpec& es, const ArmDescription& a,
-                               const std::string& where, AnyEffect& e) {
+SOFTRNE_SIM_INLINE void read_effect_params(const io::EffectSpec& es, const ArmDescription& a,
+                                           const std::string& where, AnyEffect& e)
+#if SOFTRNE_SIM_BODIES
+{
   EffectBase& b = effect_base(e);
   const int nk = effect_num_kinds(e);
   std::string kinds;
@@ -293,12 +306,17 @@ inline void read_effect_params(const io::EffectSpec& es, const ArmDescription& a
   }
   throw std::invalid_argument(where + ": field 'params': inconsistent parameter names");
 }
+#else
+;
+#endif
 
 }  // namespace detail
 
 /// \brief Builds the description from a robot spec; its `effects` become model effects.
 /// Throws std::invalid_argument naming the effect and field on an inconsistent effect.
-inline ArmDescription build_arm(const io::RobotSpec& spec) {
+SOFTRNE_SIM_INLINE ArmDescription build_arm(const io::RobotSpec& spec)
+#if SOFTRNE_SIM_BODIES
+{
   ArmDescription a;
   a.spec = spec;
   a.spec.effects.clear();
@@ -371,9 +389,14 @@ inline ArmDescription build_arm(const io::RobotSpec& spec) {
   }
   return a;
 }
+#else
+;
+#endif
 
 /// \brief The effects as robot-file entries (formats.md section 4), parameters by name.
-inline std::vector<io::EffectSpec> effect_specs(const ArmDescription& a) {
+SOFTRNE_SIM_INLINE std::vector<io::EffectSpec> effect_specs(const ArmDescription& a)
+#if SOFTRNE_SIM_BODIES
+{
   std::vector<io::EffectSpec> out;
   for (const auto& e : a.effects) {
     io::EffectSpec s;
@@ -386,10 +409,15 @@ inline std::vector<io::EffectSpec> effect_specs(const ArmDescription& a) {
   }
   return out;
 }
+#else
+;
+#endif
 
 /// \brief The robot spec with the description's current stiffness, damping, pressure maps and
 /// effects written back (what `softrne-fit` saves).
-inline io::RobotSpec to_robot_spec(const ArmDescription& a) {
+SOFTRNE_SIM_INLINE io::RobotSpec to_robot_spec(const ArmDescription& a)
+#if SOFTRNE_SIM_BODIES
+{
   io::RobotSpec s = a.spec;
   for (const auto& j : a.joints) {
     auto& seg = s.segments[static_cast<std::size_t>(j.segment)];
@@ -405,6 +433,9 @@ inline io::RobotSpec to_robot_spec(const ArmDescription& a) {
   s.effects = effect_specs(a);
   return s;
 }
+#else
+;
+#endif
 
 /// \brief Evaluates the arm's state equation x' = f(x, p) for one scalar type: eq. 23 with the
 /// effects. Holds its chain and workspace, so evaluation allocates nothing.
@@ -513,8 +544,10 @@ class ArmDynamics {
 /// \brief Initial state: at rest at the first measured configuration with the measurement
 /// model inverted (q0 = (y0 - offset) ./ gain), effect states from q0 and the first recorded
 /// pressures. An empty y0 means q0 = 0.
-inline Eigen::VectorXd initial_state(const ArmDescription& d, const Eigen::VectorXd& q0_measured,
-                                     const Eigen::VectorXd& p0) {
+SOFTRNE_SIM_INLINE Eigen::VectorXd initial_state(const ArmDescription& d, const Eigen::VectorXd& q0_measured,
+                                                 const Eigen::VectorXd& p0)
+#if SOFTRNE_SIM_BODIES
+{
   Eigen::VectorXd x = Eigen::VectorXd::Zero(d.num_states());
   if (q0_measured.size() == d.nq) x.head(d.nq) = d.coordinates_from_measured(q0_measured);
   const Eigen::VectorXd q0 = x.head(d.nq);
@@ -524,5 +557,8 @@ inline Eigen::VectorXd initial_state(const ArmDescription& d, const Eigen::Vecto
   }
   return x;
 }
+#else
+;
+#endif
 
 }  // namespace softrne

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
+#include "softrne/config.hpp"
 #include "softrne/algorithms/rnea.hpp"
 #include "softrne/model/arm_model.hpp"
 #include "softrne/sim/cvode.hpp"
@@ -341,9 +342,11 @@ class ScaledSystem {
 
 /// \brief Simulates the arm on the time grid t with the recorded pressures (N x num_inputs),
 /// from rest at the measured configuration q0 (size nq; zero if empty).
-inline ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::VectorXd& t,
-                                  const Eigen::MatrixXd& pressures, const Eigen::VectorXd& q0,
-                                  const ArmSimulationOptions& opt = {}) {
+SOFTRNE_SIM_INLINE ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::VectorXd& t,
+                                              const Eigen::MatrixXd& pressures, const Eigen::VectorXd& q0,
+                                              const ArmSimulationOptions& opt = {})
+#if SOFTRNE_SIM_BODIES
+{
   using PI = ArmSimulationOptions::PressureInterpolation;
   ArmSimulation out;
   const bool smoothing = opt.pressure_smoothing > 0;
@@ -384,5 +387,8 @@ inline ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::Vecto
   if (rows > 0) out.angles.rowwise() += offset.transpose();
   return out;
 }
+#else
+;
+#endif
 
 }  // namespace softrne::sim
