@@ -225,6 +225,9 @@ def score(res, report):
     found = read_found(report)
     res["found"] = [f"{n}:{s}" + ("" if s == "shared" else "[" + ",".join(j) + "]") for n, s, j, _ in found]
     res["report_format"] = report.get("format", "?")
+    inertia = report.get("inertia_model") or {}
+    res["inertia"] = f"distributed (round {inertia.get('round')})" if inertia.get("chosen") == "distributed" else "as declared"
+    res["removed"] = [e.get("label", e.get("name", "?")) for e in report.get("removed_effects", [])]
     b, fin = median_of(report, "baseline", "test"), median_of(report, "final", "test")
     res["test_before"], res["test_after"] = b, fin
     at_floor = fin <= FLOOR_FACTOR * FLOOR
@@ -272,17 +275,20 @@ def injected_text(r):
 
 
 def render(results, args, excluded):
-    lines = ["| case | arm | injected | found | test median before -> after (rad) | time (s) | verdict |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+    lines = ["| case | arm | injected | found | inertia | test median before -> after (rad) | time (s) | verdict |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in results:
         found = ", ".join(r.get("found", [])) or ("none" if "found" in r else "-")
+        if r.get("removed"):
+            found += " (removed: " + ", ".join(r["removed"]) + ")"
         if "test_before" in r:
             tm = f"{fmt(r['test_before'])} -> {fmt(r['test_after'])}" + (" (floor)" if r.get("at_floor") else "")
         else:
             tm = "-"
         t = f"{r['seconds']:.0f}" if "seconds" in r else "-"
         verdict = r["verdict"] + (f": {r['error']}" if "error" in r else "")
-        lines.append(f"| {r['seed']} | {r.get('arm', '-')} | {injected_text(r)} | {found} | {tm} | {t} | {verdict} |")
+        lines.append(f"| {r['seed']} | {r.get('arm', '-')} | {injected_text(r)} | {found} | {r.get('inertia', '-')} "
+                     f"| {tm} | {t} | {verdict} |")
     scored = [r for r in results if r["verdict"] not in ("gen-failed", "loop-failed")]
     eff = [r for r in scored if r.get("injected")]
     ctrl = [r for r in scored if not r.get("injected")]
@@ -301,6 +307,8 @@ def render(results, args, excluded):
         "test_improved_or_floor": sum(bool(r.get("halved") or r.get("at_floor")) for r in eff),
         "harm": sum(bool(r.get("harm")) for r in scored),
         "median_seconds": statistics.median(times) if times else float("nan"),
+        "max_seconds": max(times) if times else float("nan"),
+        "distributed_inertia_adopted": sum(str(r.get("inertia", "")).startswith("distributed") for r in scored),
         "excluded_from_pool": excluded,
     }
     per = {}
@@ -321,7 +329,8 @@ def render(results, args, excluded):
               f"{pct(s['test_improved_or_floor'], s['effect_cases'])}",
               f"- false positives on controls: {pct(s['control_false_positives'], s['controls'])}",
               f"- final test median above baseline by > {100 * HARM_TOL:.0f} %: {pct(s['harm'], s['scored'])}",
-              f"- median time per case: {s['median_seconds']:.0f} s",
+              f"- median time per case: {s['median_seconds']:.0f} s (max {s['max_seconds']:.0f} s)",
+              f"- distributed inertia adopted: {s['distributed_inertia_adopted']} of {s['scored']}",
               "- named per effect: " + (", ".join(f"{k} {v}" for k, v in s["named_per_effect"].items()) or "-")]
     if excluded:
         lines.append("- not in the pool (this build of the library does not accept them): " + ", ".join(excluded))

@@ -8,6 +8,7 @@
 #include <random>
 #include <set>
 
+#include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/fit/loop.hpp"
 #include "synthetic_arm.hpp"
 
@@ -157,6 +158,62 @@ TEST(LoopScreen, PredictsTheExactGainOfAnOffsetAndNoneForAnAbsentEffect) {
     EXPECT_LE(screen[i].predicted_gain, screen[static_cast<std::size_t>(offset_joint2)].predicted_gain + 1e-9)
         << cands[i].label;
   EXPECT_LT(screen[static_cast<std::size_t>(stiffening)].predicted_gain, 0.5);
+}
+
+TEST(LoopParts, WithoutEffectIsTheArmBuiltWithoutIt) {
+  // Reference: the arm built directly with the other effects, in their order. Effects with
+  // internal states (actuator lag, Dahl hysteresis) around one without (an angle offset), so
+  // that removing the first shifts the others' state slices.
+  const ArmDescription base = build_arm(softrne_test::two_joint_spec());
+  auto lag = make_effect_at_neutral("actuator_lag", base, Scope::Shared);
+  effect_base(lag).params.setConstant(0.08);
+  auto offset = make_effect_at_neutral("angle_offset", base, Scope::PerCoordinate, {1});
+  effect_base(offset).params << 0.02, -0.01;
+  auto dahl = make_effect_at_neutral("hysteresis", base, Scope::Shared);
+  effect_base(dahl).params << 0.3, 40.0;
+  ArmDescription all = base, expected = base;
+  for (const auto& e : {lag, offset, dahl}) add_effect(all, e);
+  for (const auto& e : {offset, dahl}) add_effect(expected, e);
+  const ArmDescription got = fit::detail::without_effect(all, 0);
+  ASSERT_EQ(got.effects.size(), 2u);
+  EXPECT_EQ(effect_name(got.effects[0]), "angle_offset");
+  EXPECT_EQ(effect_name(got.effects[1]), "hysteresis");
+  EXPECT_EQ(got.num_effect_states, expected.num_effect_states);
+  EXPECT_EQ(got.effect_state_offsets, expected.effect_state_offsets);
+  EXPECT_LT(got.num_effect_states, all.num_effect_states);
+  const io::Dataset data = softrne_test::synthetic_dataset(all, 3.0, 0.7, 5u);
+  sim::ArmSimulationOptions o;
+  const Eigen::MatrixXd a = fit::detail::simulated_angles(got, data, o);
+  const Eigen::MatrixXd b = fit::detail::simulated_angles(expected, data, o);
+  ASSERT_GT(a.size(), 0);
+  EXPECT_EQ((a - b).cwiseAbs().maxCoeff(), 0.0);
+  // Positive control: the removed effect did change the motion.
+  const Eigen::MatrixXd c = fit::detail::simulated_angles(all, data, o);
+  EXPECT_GT((a - c).cwiseAbs().maxCoeff(), 1e-3);
+}
+
+TEST(LoopParts, DistributeInertiaSwitchesLumpedCcJointsOnly) {
+  ArmDescription d = build_arm(softrne_test::two_joint_spec());
+  ASSERT_TRUE(fit::detail::distribute_cc_inertia(d));
+  int cc = 0;
+  for (const auto& seg : d.spec.segments)
+    if (const auto* j = std::get_if<io::CCJointSpec>(&seg)) {
+      ++cc;
+      EXPECT_EQ(j->inertia_model, "distributed");
+    }
+  EXPECT_EQ(cc, 2);
+  EXPECT_FALSE(fit::detail::distribute_cc_inertia(d));  // nothing left to switch
+  // The chain it builds has the distributed joints: a different mass matrix at a bent pose.
+  const ArmDescription lumped = build_arm(softrne_test::two_joint_spec());
+  auto cl = lumped.make_chain<double>();
+  auto cd = d.make_chain<double>();
+  auto dl = cl.make_data();
+  auto dd = cd.make_data();
+  Eigen::VectorXd q(4);
+  q << 0.4, -0.2, 0.3, 0.1;
+  const Eigen::MatrixXd ml = softrne::mass_matrix(cl, dl, q);
+  const Eigen::MatrixXd md = softrne::mass_matrix(cd, dd, q);
+  EXPECT_GT((ml - md).cwiseAbs().maxCoeff(), 1e-6 * ml.cwiseAbs().maxCoeff());
 }
 
 }  // namespace

@@ -21,6 +21,7 @@ struct Case {
   std::string label;
   std::vector<Injected> effects;
   unsigned seed;
+  bool distributed_truth = false;  ///< data from distributed-inertia CC joints, declared lumped
 };
 
 ArmDescription truth_of(const ArmDescription& declared, const Case& c) {
@@ -30,6 +31,7 @@ ArmDescription truth_of(const ArmDescription& declared, const Case& c) {
     for (std::size_t k = 0; k < inj.params.size(); ++k) effect_base(e).params(static_cast<Eigen::Index>(k)) = inj.params[k];
     add_effect(d, e);
   }
+  if (c.distributed_truth) fit::detail::distribute_cc_inertia(d);
   return d;
 }
 
@@ -77,6 +79,12 @@ TEST_P(LoopCase, NamesTheEffectsWithTheirScopesAndNothingElse) {
     // At the noise floor or halved.
     EXPECT_LT(r.final_test.total.median, std::max(0.5 * r.baseline_test.total.median, 1.25 * r.noise_floor)) << why;
   }
+  // The inertia model is a structure without parameters; on lumped data it may go either way,
+  // on distributed data it must not be replaced by an effect (checked above).
+  std::printf("[ info ] %s: inertia model %s (held-out", c.label.c_str(),
+              r.inertia.adopted ? "distributed adopted" : "as declared");
+  for (double g : r.inertia.fold_gains) std::printf(" %+.1f %%", -100 * g);
+  std::printf(")\n");
   std::printf("[ info ] %s: %zu effect(s); test median %.4f -> %.4f rad (floor %.4f); %d simulations, %.0f s\n",
               c.label.c_str(), r.added.size(), r.baseline_test.total.median, r.final_test.total.median,
               r.noise_floor, r.simulations, r.wall_seconds);
@@ -85,6 +93,7 @@ TEST_P(LoopCase, NamesTheEffectsWithTheirScopesAndNothingElse) {
 INSTANTIATE_TEST_SUITE_P(
     Fixed, LoopCase,
     ::testing::Values(Case{"none_seed21", {}, 21u}, Case{"none_seed22", {}, 22u},
+                      Case{"none_distributed_truth", {}, 23u, true},
                       Case{"stiffening_joint2", {{"stiffening", Scope::PerJoint, {1}, {4.0}}}, 11u},
                       Case{"coulomb_friction_shared", {{"coulomb_friction", Scope::Shared, {0, 1}, {1.0}}}, 12u},
                       Case{"lag_and_offset",

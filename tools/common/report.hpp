@@ -110,6 +110,28 @@ inline nlohmann::ordered_json loop_report_json(const fit::LoopResult& r, bool ha
     effects.push_back(x);
   }
   j["effects"] = effects;
+  // Added in a round, removed by the backward pass once later effects were in.
+  nlohmann::ordered_json removed = nlohmann::ordered_json::array();
+  for (const auto& a : r.removed) {
+    nlohmann::ordered_json fg = nlohmann::ordered_json::array();
+    for (double g : a.fold_gains) fg.push_back(finite_or_null(g));
+    removed.push_back({{"name", effect_name(a.effect)},
+                       {"label", a.label},
+                       {"scope", scope_name(effect_base(a.effect).scope)},
+                       {"fold_gains", fg},
+                       {"evidence", a.evidence}});
+  }
+  j["removed_effects"] = removed;
+  // The CC joints' inertia model: a structure the loop may change (no parameters), not an effect.
+  nlohmann::ordered_json inertia;
+  inertia["tried"] = r.inertia.tried;
+  inertia["chosen"] = r.inertia.adopted ? "distributed" : "as declared";
+  nlohmann::ordered_json ig = nlohmann::ordered_json::array();
+  for (double g : r.inertia.fold_gains) ig.push_back(finite_or_null(g));
+  inertia["fold_gains"] = ig;
+  inertia["round"] = r.inertia.round;
+  inertia["min_gain"] = opt.inertia_min_gain;
+  j["inertia_model"] = inertia;
   nlohmann::ordered_json fin;
   fin["train"] = stats_json(r.final_train);
   if (has_test) fin["test"] = stats_json(r.final_test);
