@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
     args.option("threads", "N", "parallel simulations (default 2)");
     args.flag("quiet", "no progress line");
     if (!args.parse(argc, argv)) return cli::kExitOk;
+    cli::check_outputs_are_not_inputs(args, {"robot", "data", "test"}, {"out"});
     const io::RobotSpec spec = io::read_robot_json(args.value("robot"));
     const io::Dataset train = io::read_dataset(args.value("data"), spec, true);
     io::Dataset test;
@@ -38,8 +39,8 @@ int main(int argc, char** argv) {
     }
     fit::ArmFitOptions opt;
     opt.pressure_gain = args.has("pressure-gain");
-    opt.optimiser.seed = static_cast<unsigned>(args.number("seed", 1, 0, 4e9));
-    opt.optimiser.threads = static_cast<int>(args.number("threads", 2, 1, 64));
+    opt.optimiser.seed = static_cast<unsigned>(args.integer("seed", 1, 0, 4294967295L));
+    opt.optimiser.threads = static_cast<int>(args.integer("threads", 2, 1, 64));
     const bool quiet = args.has("quiet");
     if (!quiet)
       opt.optimiser.progress = [nq = desc.nq](int evals, double cost) {
@@ -54,11 +55,14 @@ int main(int argc, char** argv) {
     };
     const ErrorStats train_before = before(train);
     fit::ArmFitResult r;
+    cli::stop_on_interrupt();
+    opt.simulation.cvode.stop = &cli::interrupted;
     try {
       r = fit::fit_arm(desc, train, opt);
     } catch (const std::invalid_argument& e) {
       throw cli::Failure(e.what());
     }
+    cli::throw_if_interrupted("the fit");
     if (!quiet) std::fprintf(stderr, "\n");
     if (!std::isfinite(r.fit.cost)) throw cli::Failure(train.source + ": the fit found no parameters that simulate: " + r.fit.message);
     io::write_robot_json(to_robot_spec(r.fitted), args.value("out"));

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -19,8 +20,11 @@ namespace {
 void write_plot_data(const std::string& dir, const softrne::fit::LoopResult& r, const softrne::io::Dataset& train,
                      const softrne::io::Dataset& test, const softrne::fit::LoopOptions& opt) {
   using namespace softrne;
-  if (std::system(("mkdir -p '" + dir + "'").c_str()) != 0)
-    throw io::InputError(io::Category::WriteFailed, dir, "", "cannot create the plot folder");
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw io::InputError(io::Category::WriteFailed, dir, "", "cannot create the plot folder" +
+                         (ec ? ": " + ec.message() : std::string()));
   auto sim = [&](const ArmDescription& d, const io::Dataset& data, const std::string& name) {
     const auto s = fit::simulate_dataset(d, data, opt.fit.simulation);
     if (s.ok()) io::write_trajectory_csv(dir + "/" + name, data.t, s.angles, d.coordinate_names);
@@ -63,6 +67,7 @@ int main(int argc, char** argv) {
     args.option("max-effects", "N", "at most this many effects (default 4)");
     args.flag("quiet", "no progress lines");
     if (!args.parse(argc, argv)) return cli::kExitOk;
+    cli::check_outputs_are_not_inputs(args, {"robot", "train", "test"}, {"out"});
     const io::RobotSpec spec = io::read_robot_json(args.value("robot"));
     const io::Dataset train = io::read_dataset(args.value("train"), spec, true);
     const io::Dataset test = io::read_dataset(args.value("test"), spec, true);
@@ -73,24 +78,31 @@ int main(int argc, char** argv) {
       throw cli::Failure(args.value("robot") + ": " + e.what());
     }
     fit::LoopOptions opt;
-    opt.fit.optimiser.threads = static_cast<int>(args.number("threads", 2, 1, 64));
-    opt.max_effects = static_cast<int>(args.number("max-effects", 4, 0, 16));
+    opt.fit.optimiser.threads = static_cast<int>(args.integer("threads", 2, 1, 64));
+    opt.max_effects = static_cast<int>(args.integer("max-effects", 4, 0, 16));
     if (!args.has("quiet")) opt.log = [](const std::string& s) { std::fprintf(stderr, "softrne-loop: %s\n", s.c_str()); };
     fit::LoopResult r;
+    cli::stop_on_interrupt();
+    opt.fit.simulation.cvode.stop = &cli::interrupted;
     try {
       r = fit::run_loop(desc, train, &test, opt);
     } catch (const std::invalid_argument& e) {
       throw cli::Failure(e.what());
     }
+    cli::throw_if_interrupted("the closed loop");
     if (args.has("plots")) write_plot_data(args.value("plots"), r, train, test, opt);
-    {
-      std::ofstream f(args.value("out"));
-      if (!f) throw io::InputError(io::Category::WriteFailed, args.value("out"), "", "cannot write the report");
-      f << cli::loop_report_json(r, true, opt).dump(2) << "\n";
-    }
+    io::detail::write_text_file(args.value("out"), cli::loop_report_json(r, true, opt).dump(2) + "\n");
     std::printf("closed loop in %.1f s (%d simulations)\n", r.wall_seconds, r.simulations);
     std::printf("sensor noise estimated from the training angles: floor (median |error| of noise alone) %.4f rad\n",
                 r.noise_floor);
+    if (r.inertia.tried) {
+      std::printf("inertia model of the CC joints: distributed instead of lumped, held-out");
+      for (double g : r.inertia.fold_gains) std::printf(" %+6.1f %%", -100 * g);
+      if (r.inertia.adopted)
+        std::printf(" -> adopted in round %d\n", r.inertia.round);
+      else
+        std::printf(" (last try) -> kept as declared\n");
+    }
     for (std::size_t k = 0; k < r.rounds.size(); ++k) {
       std::printf("round %zu: candidates by predicted held-out gain (screen), refitted ones with the measured gain\n",
                   k + 1);
@@ -107,8 +119,11 @@ int main(int argc, char** argv) {
         std::printf("%s\n", c.added ? "   -> added" : "");
       }
     }
-    if (r.added.empty()) std::printf("no effect earned its place: the declared model stands\n");
+    if (r.added.empty())
+      std::printf(r.inertia.adopted ? "no effect earned its place\n"
+                                    : "no effect earned its place: the declared model stands\n");
     for (const auto& a : r.added) std::printf("added %s: %s\n", a.label.c_str(), a.evidence.c_str());
+    for (const auto& a : r.removed) std::printf("removed %s: %s\n", a.label.c_str(), a.evidence.c_str());
     std::printf("%s\n", r.unexplained_train.statement.c_str());
     std::printf("%s", cli::parameter_table(r.final_fit).c_str());
     std::printf("%s", format_error_table(r.baseline.stats, "train, baseline").c_str());

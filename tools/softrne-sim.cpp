@@ -109,6 +109,7 @@ int run_sim(int argc, char** argv) {
       "              --pressures examples/data/arm-a-1/test.csv --out sim.csv\n\n" +
       softrne::cli::ArgParser::exit_code_text());
   if (!args.parse(argc, argv)) return softrne::cli::kExitOk;
+  softrne::cli::check_outputs_are_not_inputs(args, {"robot", "pressures"}, {"out"});
 
   const std::string robot_path = args.value("robot");
   const std::string data_path = args.value("pressures");
@@ -151,6 +152,8 @@ int run_sim(int argc, char** argv) {
 
   Progress progress(!quiet && softrne::cli::stderr_is_terminal(), t0, t1);
   opt.progress = [&](double t) { progress.update(t); };
+  softrne::cli::stop_on_interrupt();
+  opt.cvode.stop = &softrne::cli::interrupted;
   const softrne::sim::ArmSimulation sim =
       softrne::sim::simulate_arm(desc, data.t, data.pressures, q0, opt);
   progress.finish();

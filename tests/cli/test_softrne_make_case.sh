@@ -12,13 +12,8 @@ if [[ $# -ne 2 ]]; then
 fi
 make_case=$1
 sim=$2
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/softrne-make-case.XXXXXX")
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-  echo "FAIL: $*"
-  failures=$((failures + 1))
-}
+source "$(dirname "$0")/common.sh"
+make_scratch softrne-make-case
 
 for spec in "none:--none" "stiffening:--effects stiffening:joint"; do
   name=${spec%%:*}
@@ -64,8 +59,4 @@ done
 "$make_case" --list-effects >"$tmp/list.txt" || fail "--list-effects failed"
 grep -q "^stiffening	shared	yes" "$tmp/list.txt" || fail "--list-effects: stiffening shared does not build"
 
-if [[ $failures -ne 0 ]]; then
-  echo "$failures failure(s)"
-  exit 1
-fi
-echo "all passed"
+finish

@@ -20,15 +20,9 @@ fi
 robot=$data/robot.json
 csv=$data/test.csv
 
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/softrne-cli.XXXXXX")
-trap 'rm -rf "$tmp"' EXIT
+source "$(dirname "$0")/common.sh"
+make_scratch softrne-cli
 cd "$tmp" || exit 1
-
-failures=0
-fail() {
-  echo "FAIL: $*"
-  failures=$((failures + 1))
-}
 
 # expect_error <name> <text the one line must contain> <args...>
 expect_error() {
@@ -139,8 +133,33 @@ else
   fail "good run: exit status $?; stderr: $(cat err.txt)"
 fi
 
-if [[ $failures -ne 0 ]]; then
-  echo "$failures check(s) failed"
-  exit 1
+# ---- a tool never overwrites its input; outputs are replaced whole ---------------------
+cp "$csv" own.csv
+sum_before=$(cksum <own.csv)
+expect_error "--out is the input" "refusing to overwrite an input" --robot "$robot" --pressures own.csv \
+  --out ./own.csv
+ln -s own.csv link.csv
+expect_error "--out is a link to the input" "refusing to overwrite an input" --robot "$robot" \
+  --pressures own.csv --out link.csv
+if [[ $(cksum <own.csv) != "$sum_before" ]]; then
+  fail "the input was changed by a refused run"
+else
+  echo "ok   the input is intact after the refused runs"
 fi
-echo "all checks passed"
+printf 'old content that is longer than nothing\n' >old.csv
+if "$tool" --robot "$robot" --pressures own.csv --out old.csv >/dev/null 2>err.txt </dev/null &&
+  [[ $(head -1 old.csv) == "t,u1,v1,u2,v2,u3,v3" ]] && ! ls ./*.part-* >/dev/null 2>&1; then
+  echo "ok   an existing output is replaced whole, no temporary file left"
+else
+  fail "replacing old.csv: $(cat err.txt); $(ls)"
+fi
+if "$tool" --robot "$robot" --pressures own.csv --out /dev/null >/dev/null 2>err.txt </dev/null &&
+  [[ -c /dev/null ]]; then
+  echo "ok   --out /dev/null writes to the device (not over it)"
+else
+  fail "--out /dev/null: $(cat err.txt)"
+fi
+expect_error "unwritable output folder" "no-such-dir/s.csv" --robot "$robot" --pressures own.csv \
+  --out no-such-dir/s.csv
+
+finish

@@ -23,11 +23,13 @@
 /// run() prints the one line and returns the exit code. It never lets an exception escape.
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <limits>
@@ -47,14 +49,45 @@
 
 namespace softrne::cli {
 
-/// \brief Exit codes of the tools (all < 128, so never confused with a signal).
+/// \brief Exit codes of the tools (all < 128, so never confused with a signal, except the
+/// one that reports Ctrl-C the way a shell does).
 enum ExitCode : int {
   kExitOk = 0,        ///< success
   kExitFailure = 1,   ///< the computation failed (integrator failure, fit diverged, ...)
   kExitUsage = 2,     ///< bad command line: unknown option, missing or malformed value
   kExitInput = 3,     ///< a bad input file (missing, unreadable, malformed) or unwritable output
   kExitInternal = 4,  ///< an unexpected internal error (a bug: please report it)
+  /// Stopped by Ctrl-C (SIGINT) after a clean stop: nothing was written. 128 + SIGINT, as a
+  /// shell reports a command killed by Ctrl-C, so scripts treat it alike.
+  kExitInterrupted = 130,
 };
+
+/// \brief Set by Ctrl-C (SIGINT) once stop_on_interrupt() ran; point the simulator's
+/// `CvodeOptions::stop` at it, so that a long fit or loop ends within one simulation step.
+inline std::atomic<bool> interrupted{false};
+
+/// \brief A stop on request (Ctrl-C); run() prints the message and returns kExitInterrupted.
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// \brief From now on the first Ctrl-C sets `interrupted` (the tool stops cleanly and says
+/// so); a second one kills the process as usual.
+inline void stop_on_interrupt() {
+#ifdef SOFTRNE_CLI_POSIX
+  std::signal(SIGINT, [](int) {
+    interrupted.store(true);
+    std::signal(SIGINT, SIG_DFL);
+  });
+#endif
+}
+
+/// \brief Throws Interrupted if Ctrl-C was pressed: call after a long computation, before
+/// writing its results (which may be incomplete).
+inline void throw_if_interrupted(const std::string& what) {
+  if (interrupted.load()) throw Interrupted("interrupted (Ctrl-C) during " + what + ": nothing written");
+}
 
 /// \brief A bad command line; `what()` is the message after `<tool>: `.
 class UsageError : public std::runtime_error {
@@ -94,13 +127,24 @@ int run(const std::string& tool, Body&& body) noexcept {
     } catch (const UsageError& e) {
       print_error(tool, std::string(e.what()) + " (see --help)");
       return kExitUsage;
+    } catch (const Interrupted& e) {
+      print_error(tool, e.what());
+      return kExitInterrupted;
     } catch (const Failure& e) {
+      if (interrupted.load()) {  // a run that failed because it was stopped
+        print_error(tool, "interrupted (Ctrl-C): nothing written");
+        return kExitInterrupted;
+      }
       print_error(tool, e.what());
       return kExitFailure;
     } catch (const std::bad_alloc&) {
       print_error(tool, "out of memory");
       return kExitInternal;
     } catch (const std::exception& e) {
+      if (interrupted.load()) {  // whatever a stopped computation threw
+        print_error(tool, "interrupted (Ctrl-C): nothing written");
+        return kExitInterrupted;
+      }
       print_error(tool, std::string("internal error: ") + e.what());
       return kExitInternal;
     } catch (...) {
@@ -367,5 +411,23 @@ class ArgParser {
   std::string tool_, synopsis_, description_, epilog_;
   std::vector<Option> opts_;
 };
+
+/// \brief Refuses (UsageError) an output option that names one of the input files: a tool
+/// never overwrites what it reads. Files are compared as files (std::filesystem::equivalent:
+/// `./run.csv`, `run.csv` and a link to it are the same). Options not given are skipped.
+inline void check_outputs_are_not_inputs(const ArgParser& args, const std::vector<std::string>& inputs,
+                                         const std::vector<std::string>& outputs) {
+  namespace fs = std::filesystem;
+  for (const auto& out : outputs) {
+    if (!args.has(out) || args.value(out) == "-") continue;
+    for (const auto& in : inputs) {
+      if (!args.has(in)) continue;
+      std::error_code ec;
+      if (fs::equivalent(fs::path(args.value(out)), fs::path(args.value(in)), ec) && !ec)
+        throw UsageError("option --" + out + ": " + args.value(out) + " is the input given to --" + in +
+                         "; refusing to overwrite an input");
+    }
+  }
+}
 
 }  // namespace softrne::cli

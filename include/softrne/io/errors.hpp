@@ -8,6 +8,8 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -218,8 +220,9 @@ inline std::string read_text_file(const std::string& path) {
   return text;
 }
 
-/// \brief Write `text` to `path` (replacing it); InputError (WriteFailed) on failure.
-inline void write_text_file(const std::string& path, const std::string& text) {
+/// \brief Write `text` to `path` directly (truncating it first); InputError (WriteFailed) on
+/// failure. For devices and pipes; write_text_file for files.
+inline void write_text_file_in_place(const std::string& path, const std::string& text) {
   errno = 0;
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (f == nullptr) {
@@ -237,6 +240,44 @@ inline void write_text_file(const std::string& path, const std::string& text) {
   if (failed) {
     throw InputError(Category::WriteFailed, path, "",
                      std::string("cannot write file: ") + std::strerror(err != 0 ? err : EIO));
+  }
+}
+
+/// \brief Write `text` to `path` (replacing it); InputError (WriteFailed) on failure.
+///
+/// A regular file (or a new one) is replaced atomically: the text goes to a temporary file
+/// next to it, which is renamed over `path` only once it is complete, so an interrupted or
+/// failed write never leaves a truncated file, and the old content survives any failure.
+/// A path through a symbolic link replaces the link's target. Anything else (a device such as
+/// /dev/null or /dev/stdout, a pipe) is written in place.
+inline void write_text_file(const std::string& path, const std::string& text) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path target(path);
+  const fs::file_status st = fs::status(target, ec);  // follows links
+  const bool exists = !ec && fs::exists(st);
+  if (exists && !fs::is_regular_file(st)) {
+    write_text_file_in_place(path, text);
+    return;
+  }
+  if (exists && fs::is_symlink(fs::symlink_status(target, ec))) target = fs::canonical(target, ec);
+  if (ec) target = fs::path(path);
+  // Same directory, so that the rename is atomic; a name no other writer uses.
+  std::random_device rd;
+  char suffix[32];
+  std::snprintf(suffix, sizeof suffix, ".part-%08x", static_cast<unsigned>(rd()));
+  const std::string tmp = target.string() + suffix;
+  try {
+    write_text_file_in_place(tmp, text);
+  } catch (const InputError& e) {
+    std::remove(tmp.c_str());
+    throw InputError(Category::WriteFailed, path, "", e.detail());  // the user's path, not tmp
+  }
+  if (std::rename(tmp.c_str(), target.string().c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    throw InputError(Category::WriteFailed, path, "",
+                     std::string("cannot replace file: ") + std::strerror(err));
   }
 }
 

@@ -32,6 +32,7 @@
 /// which would copy the state into a new heap vector on every call.
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -62,6 +63,10 @@ struct CvodeOptions {
   double atol = 1e-8;           ///< absolute tolerance (all components)
   long max_steps = 100000;      ///< internal steps in total over the run
   double max_wall_seconds = 0;  ///< wall-clock limit; 0 = none
+  /// Cancellation: when `*stop` becomes true (a tool's SIGINT handler sets it), the run
+  /// fails at the next right-hand-side evaluation with "stopped on request". Null: never.
+  /// A fit or the closed loop built on these runs then ends within one simulation step.
+  const std::atomic<bool>* stop = nullptr;
   double max_step = 0;          ///< largest step size; 0 = CVODE default (none)
   /// Smallest step size; 0 = a roundoff floor, 256 eps max(1, |t0|, |t_end|).
   /// Without a floor, an rhs that fails for all t > t* makes CVODE creep up to
@@ -189,9 +194,11 @@ struct CallbackData {
   Eigen::Index n = 0;
   Clock::time_point start;
   double max_wall_seconds = 0;
+  const std::atomic<bool>* stop = nullptr;
   bool verbose = false;
   // Failure bookkeeping, read after CVode returns.
   bool wall_exceeded = false;
+  bool stopped = false;
   bool rhs_nonfinite = false;  // the rhs produced NaN/Inf at least once
   double t_rhs_nonfinite = 0;  // first such time
   bool rhs_refused = false;    // the rhs returned false at least once
@@ -199,7 +206,12 @@ struct CallbackData {
   std::exception_ptr exception;
   std::string last_error;  // CVODE's last error message (error path only)
 
+  /// The wall-clock limit, or a stop request (reported as such).
   bool wall_clock_exceeded() {
+    if (stop && stop->load(std::memory_order_relaxed)) {
+      stopped = true;
+      wall_exceeded = true;
+    }
     if (max_wall_seconds > 0 &&
         std::chrono::duration<double>(Clock::now() - start).count() > max_wall_seconds)
       wall_exceeded = true;
@@ -424,6 +436,7 @@ SimulationResult integrate(System& sys, const Eigen::VectorXd& x0,
   data.n = n;
   data.start = start;
   data.max_wall_seconds = opt.max_wall_seconds;
+  data.stop = opt.stop;
   data.verbose = opt.verbose;
 
   auto setup_error = [&](const char* what) {
@@ -521,6 +534,7 @@ SimulationResult integrate(System& sys, const Eigen::VectorXd& x0,
         std::rethrow_exception(data.exception);
       }
       if (flag < 0) {
+        if (data.stopped) return failure("stopped on request", tret);
         if (data.wall_exceeded)
           return failure("wall-clock limit (" + format_time(opt.max_wall_seconds) + " s) exceeded",
                          tret);
