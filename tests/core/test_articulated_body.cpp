@@ -2,7 +2,7 @@
 // dense solve (forward_dynamics: M from mass_matrix, Cholesky) on random hybrid chains of
 // 1..100 segments and compile-time chains; own_body_inertia against the mass matrix and an
 // independent construction; AutoDiff derivatives against M^-1; no heap allocation.
-#define EIGEN_RUNTIME_NO_MALLOC
+#include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -111,7 +111,7 @@ Errors aba_vs_dense(const ChainT& chain, std::mt19937& rng, int states, double q
     EXPECT_TRUE(b.allFinite());
     e.forward = std::max(e.forward, rel_err(a, b));
     const MatrixXd M = d2.mass_matrix;
-    const VectorXd r = tau - d2.bias_forces;
+    const VectorXd r = tau - d2.nonlinear_forces;
     const double Mn = M.cwiseAbs().rowwise().sum().maxCoeff();
     e.backward = std::max(e.backward, (M * a - r).cwiseAbs().maxCoeff() /
                                           (Mn * a.cwiseAbs().maxCoeff() + r.cwiseAbs().maxCoeff()));
@@ -371,7 +371,7 @@ TEST(OwnBodyInertia, BodyRigidWithTheDistalFrameWouldBeWrong) {
   std::printf("[ info ] lone CC joint: |D_rigid - M| / |M| = %.3f (aba uses J_com: M exactly)\n",
               rigid_err);
   EXPECT_GT(rigid_err, 1e-2);
-  const Eigen::Vector2d a_rigid = D_rigid.ldlt().solve(tau - dense.bias_forces);
+  const Eigen::Vector2d a_rigid = D_rigid.ldlt().solve(tau - dense.nonlinear_forces);
   EXPECT_GT(rel_err(a_rigid, a), 1e-2);
 }
 
@@ -461,11 +461,16 @@ TEST(ArticulatedBodyAllocation, NoHeapAllocation) {
   auto dd = dyn.make_data();
   const VectorXd qx = VectorXd::Constant(6, 0.3), qdx = VectorXd::Constant(6, -0.5),
                  tx = VectorXd::Ones(6);
+  const long eigen_failures_before = softrne_test::eigen_assert_failures;
   Eigen::internal::set_is_malloc_allowed(false);
   aba(arm, ds, q, qd, tau);
   aba(dyn, dd, qx, qdx, tx);
   Eigen::internal::set_is_malloc_allowed(true);
+  EXPECT_EQ(softrne_test::eigen_assert_failures, eigen_failures_before)
+      << "heap allocation where forbidden";
   EXPECT_TRUE(ds.qddot.allFinite() && dd.qddot.allFinite());
 }
+
+SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
 
 }  // namespace

@@ -1,7 +1,7 @@
 // ConstantCurvatureJoint against references that share none of its code: the arc integrated
 // as an ODE along its length, direct sums over thin disks (paper eq. 22 with the parallel-axis
 // theorem applied here), central finite differences and Eigen AutoDiff.
-#define EIGEN_RUNTIME_NO_MALLOC
+#include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -329,11 +329,13 @@ TEST(ConstantCurvatureJoint, CalcDoesNotAllocate) {
   const Joint j = joint();
   Kin k;
   const Vector2d q(0.3, -0.4), qd(1.0, 2.0);
+  const long eigen_failures_before = softrne_test::eigen_assert_failures;
   Eigen::internal::set_is_malloc_allowed(false);
   j.calc(q, qd, k);
   j.calc(Vector2d(1.5, 0.2), qd, k);
   Eigen::internal::set_is_malloc_allowed(true);
-  SUCCEED();
+  EXPECT_EQ(softrne_test::eigen_assert_failures, eigen_failures_before)
+      << "heap allocation where forbidden";
 }
 
 TEST(ConstantCurvatureJoint, PressureMapIsEquation24) {
@@ -344,5 +346,7 @@ TEST(ConstantCurvatureJoint, PressureMapIsEquation24) {
   EXPECT_NEAR(tau(0), dA * (p(0) - p(1)), 1e-12);
   EXPECT_NEAR(tau(1), dA * (p(2) - p(3)), 1e-12);
 }
+
+SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
 
 }  // namespace

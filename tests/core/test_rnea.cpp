@@ -1,7 +1,7 @@
 // The generic RNE against the Euler-Lagrange equations of the lumped energy, differentiated
 // with AutoDiff; cross-identities between rnea, gravity, bias and mass_matrix; static chain
 // == runtime chain; closed-form statics; no heap allocation.
-#define EIGEN_RUNTIME_NO_MALLOC
+#include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -196,7 +196,7 @@ TEST(RneaIdentities, GravityBiasMassMatrix) {
       EXPECT_LT(softrne_test::rel_err(rnea(chain, data, q, qd, qdd), M * qdd + Cqd + G), 1e-13);
       mass_matrix_and_bias(chain, data, q, qd);
       EXPECT_LT(softrne_test::rel_err(data.mass_matrix, M), 1e-15);
-      EXPECT_LT(softrne_test::rel_err(data.bias_forces, Cqd + G), 1e-13);
+      EXPECT_LT(softrne_test::rel_err(data.nonlinear_forces, Cqd + G), 1e-13);
       // G = dV/dq.
       VectorXd a, b, dV;
       lagrangian_gradients(chain_ad, q, qd, a, b, dV);
@@ -272,6 +272,40 @@ TEST(RneaClosedForm, SingleJointWithTipMassStaticEquilibrium) {
   std::printf("[ info ] equilibrium u* = %.6f rad, residual %.2e N m\n", u_star, G(0) + k * u_star);
 }
 
+// The README's controller example holds references to the results of rnea, mass_matrix,
+// gravity and bias in turn, then runs forward dynamics: each result must still be its own
+// (each algorithm writes its own field), equal to the same call on a fresh Data.
+TEST(RneaReadme, ControllerExampleKeepsEachResult) {
+  using CC = ConstantCurvatureJoint<double>;
+  using RL = RigidLink<double>;
+  using Arm = Chain<CC, RL, CC, RL>;
+  const Arm arm(softrne_test::paper_cc<double>(), softrne_test::paper_link<double>(),
+                softrne_test::paper_cc<double>(), softrne_test::paper_link<double>());
+  auto data = arm.make_data();
+  Arm::VectorQ q, qd, qdd;
+  q << 0.3, -0.2, 0.5, 0.1;
+  qd << 1.0, -0.5, 0.7, 2.0;
+  qdd << 0.4, 0.3, -0.8, 1.2;
+  const Arm::VectorQ& tau = rnea(arm, data, q, qd, qdd);
+  const Arm::MatrixQ& M = mass_matrix(arm, data, q);
+  const Arm::VectorQ& G = gravity(arm, data, q);
+  const Arm::VectorQ& Cqd = bias(arm, data, q, qd);
+  const Arm::VectorQ u = Arm::VectorQ::Zero();
+  const Arm::VectorQ qdd_dense = forward_dynamics(arm, data, q, qd, u);
+  const Arm::VectorQ qdd_on = aba(arm, data, q, qd, u);
+  auto fresh = [&] { return arm.make_data(); };
+  auto d1 = fresh(), d2 = fresh(), d3 = fresh(), d4 = fresh();
+  EXPECT_EQ(tau, rnea(arm, d1, q, qd, qdd));
+  EXPECT_EQ(M, mass_matrix(arm, d2, q));
+  EXPECT_EQ(G, gravity(arm, d3, q));
+  EXPECT_EQ(Cqd, bias(arm, d4, q, qd));
+  // The three forces differ (the test could not pass if they all held one field), and agree.
+  EXPECT_GT((tau - G).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_GT((G - Cqd).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_LT(softrne_test::rel_err(tau, M * qdd + Cqd + G), 1e-13);
+  EXPECT_LT(softrne_test::rel_err(qdd_dense, qdd_on), 1e-10);
+}
+
 TEST(RneaAllocation, StaticChainAlgorithmsDoNotAllocate) {
   using CC = ConstantCurvatureJoint<double>;
   using RL = RigidLink<double>;
@@ -283,6 +317,7 @@ TEST(RneaAllocation, StaticChainAlgorithmsDoNotAllocate) {
   q << 0.1, 0.2, -0.3, 0.4, 0.5, -0.6;
   qd << 1, 2, 3, -1, -2, -3;
   qdd.setOnes();
+  const long eigen_failures_before = softrne_test::eigen_assert_failures;
   Eigen::internal::set_is_malloc_allowed(false);
   rnea(arm, data, q, qd, qdd);
   gravity(arm, data, q);
@@ -290,7 +325,8 @@ TEST(RneaAllocation, StaticChainAlgorithmsDoNotAllocate) {
   mass_matrix(arm, data, q);
   mass_matrix_and_bias(arm, data, q, qd);
   Eigen::internal::set_is_malloc_allowed(true);
-  SUCCEED();
+  EXPECT_EQ(softrne_test::eigen_assert_failures, eigen_failures_before)
+      << "heap allocation where forbidden";
 }
 
 TEST(RneaAllocation, RuntimeChainAlgorithmsDoNotAllocateAfterMakeData) {
@@ -298,11 +334,15 @@ TEST(RneaAllocation, RuntimeChainAlgorithmsDoNotAllocateAfterMakeData) {
   auto data = chain.make_data();
   const VectorXd q = VectorXd::Constant(6, 0.3), qd = VectorXd::Constant(6, -0.5),
                  qdd = VectorXd::Ones(6);
+  const long eigen_failures_before = softrne_test::eigen_assert_failures;
   Eigen::internal::set_is_malloc_allowed(false);
   rnea(chain, data, q, qd, qdd);
   mass_matrix_and_bias(chain, data, q, qd);
   Eigen::internal::set_is_malloc_allowed(true);
-  SUCCEED();
+  EXPECT_EQ(softrne_test::eigen_assert_failures, eigen_failures_before)
+      << "heap allocation where forbidden";
 }
+
+SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
 
 }  // namespace

@@ -1,7 +1,7 @@
 // clang-format off
 // The malloc guard only defines macros and must precede every Eigen include; the
 // header under test is then the first real include (it must compile on its own).
-#include "eigen_malloc_guard.hpp"
+#include "../eigen_malloc_guard.hpp"
 #include "softrne/sim/cvode.hpp"
 // clang-format on
 
@@ -433,5 +433,7 @@ TEST(Cvode, SingleOutputTimeAndBreakpointsOutsideRange) {
   for (Eigen::Index i = 0; i < times.size(); ++i)
     EXPECT_NEAR(r.x(i, 0), std::exp(-(times[i] - 1.0)), 1e-8);
 }
+
+SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
 
 }  // namespace

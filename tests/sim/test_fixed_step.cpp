@@ -1,7 +1,7 @@
 // clang-format off
 // The malloc guard only defines macros and must precede every Eigen include; the
 // header under test is then the first real include (it must compile on its own).
-#include "eigen_malloc_guard.hpp"
+#include "../eigen_malloc_guard.hpp"
 #include "softrne/sim/fixed_step.hpp"
 // clang-format on
 

@@ -296,7 +296,7 @@ bool articulated_passes(const ChainT& chain, typename ChainT::Data& data) {
 /// (eq. 23) by the articulated-body recursion of this file's comment, without forming M.
 ///
 /// Same contract as forward_dynamics(): tau holds every other generalised force (pressures,
-/// springs, dampers, effects); C qdot + G is left in data.bias_forces. If a segment's
+/// springs, dampers, effects); C qdot + G is left in data.nonlinear_forces. If a segment's
 /// articulated joint inertia D is not positive definite (never, for positive masses), qddot
 /// is set to NaN. Allocates nothing (for a built-in scalar type). Unlike forward_dynamics()
 /// it leaves no mass matrix or Cholesky factor in data.
@@ -310,9 +310,8 @@ const typename ChainT::VectorQ& aba(const ChainT& chain, typename ChainT::Data& 
                  "aba: tau must have num_coordinates() entries");
   compute_kinematics(chain, data, q, qdot);
   data.qdot_zero.setZero();
-  detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true);  // b = C qdot + G
-  data.bias_forces = data.tau;
-  data.qddot = tau - data.bias_forces;
+  detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);
+  data.qddot = tau - data.nonlinear_forces;
   if (!detail::articulated_passes(chain, data))
     data.qddot.setConstant(std::numeric_limits<double>::quiet_NaN());
   return data.qddot;

@@ -15,8 +15,8 @@ const typename ChainT::VectorQ& gravity(const ChainT& chain, typename ChainT::Da
                                         const Eigen::MatrixBase<Q>& q) {
   data.qdot_zero.setZero();
   compute_kinematics(chain, data, q, data.qdot_zero);
-  detail::rnea_passes(chain, data, data.qdot_zero, data.qdot_zero, true, false);
-  data.gravity_forces = data.tau;
+  detail::rnea_passes(chain, data, data.qdot_zero, data.qdot_zero, true, false,
+                      data.gravity_forces);
   return data.gravity_forces;
 }
 
@@ -28,8 +28,7 @@ const typename ChainT::VectorQ& bias(const ChainT& chain, typename ChainT::Data&
                                      const Eigen::MatrixBase<Qd>& qdot, bool with_gravity = false) {
   compute_kinematics(chain, data, q, qdot);
   data.qdot_zero.setZero();
-  detail::rnea_passes(chain, data, qdot, data.qdot_zero, with_gravity, true);
-  data.bias_forces = data.tau;
+  detail::rnea_passes(chain, data, qdot, data.qdot_zero, with_gravity, true, data.bias_forces);
   return data.bias_forces;
 }
 

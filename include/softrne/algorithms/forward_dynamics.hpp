@@ -63,7 +63,7 @@ const typename ChainT::VectorQ& forward_dynamics(const ChainT& chain, typename C
                                                  const Eigen::MatrixBase<Qd>& qdot,
                                                  const Eigen::MatrixBase<Tau>& tau) {
   mass_matrix_and_bias(chain, data, q, qdot);
-  data.qddot = tau - data.bias_forces;
+  data.qddot = tau - data.nonlinear_forces;
   data.mass_factor = data.mass_matrix;
   if (!detail::cholesky_solve_in_place(data.mass_factor, data.qddot))
     data.qddot.setConstant(std::numeric_limits<double>::quiet_NaN());

@@ -251,14 +251,13 @@ const typename ChainT::MatrixQ& mass_matrix(const ChainT& chain, typename ChainT
 }
 
 /// \brief M(q) and C(q,qdot) qdot + G(q) from one kinematics evaluation: what forward dynamics
-/// needs. Results in data.mass_matrix and data.bias_forces.
+/// needs. Results in data.mass_matrix and data.nonlinear_forces.
 template <class ChainT, class Q, class Qd>
 void mass_matrix_and_bias(const ChainT& chain, typename ChainT::Data& data,
                           const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot) {
   compute_kinematics(chain, data, q, qdot);
   data.qdot_zero.setZero();
-  detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true);
-  data.bias_forces = data.tau;
+  detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);
   detail::mass_matrix_passes(chain, data);
 }
 

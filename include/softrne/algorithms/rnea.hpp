@@ -18,7 +18,7 @@ namespace detail {
 template <class ChainT, class Qd, class Qdd>
 void rnea_passes(const ChainT& chain, typename ChainT::Data& data,
                  const Eigen::MatrixBase<Qd>& qdot, const Eigen::MatrixBase<Qdd>& qddot,
-                 bool with_gravity, bool velocity_terms) {
+                 bool with_gravity, bool velocity_terms, typename ChainT::VectorQ& out) {
   using Scalar = typename ChainT::Scalar;
   auto& base = data.motion[0];
   base.omega.setZero();
@@ -39,7 +39,7 @@ void rnea_passes(const ChainT& chain, typename ChainT::Data& data,
     constexpr int n = std::decay_t<decltype(seg)>::nq;
     const auto k = static_cast<std::size_t>(i);
     backward_step(seg, kin, data.loads[k], data.wrench[k + 1], chain.inertia_rate,
-                  data.tau.template segment<n>(offset), data.wrench[k]);
+                  out.template segment<n>(offset), data.wrench[k]);
   });
 }
 
@@ -57,7 +57,7 @@ const typename ChainT::VectorQ& rnea(const ChainT& chain, typename ChainT::Data&
   SOFTRNE_ASSERT(qddot.size() == chain.num_coordinates(),
                  "rnea: qddot must have num_coordinates() entries");
   compute_kinematics(chain, data, q, qdot);
-  detail::rnea_passes(chain, data, qdot, qddot, true, true);
+  detail::rnea_passes(chain, data, qdot, qddot, true, true, data.tau);
   return data.tau;
 }
 

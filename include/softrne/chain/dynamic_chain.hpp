@@ -116,7 +116,10 @@ struct DynamicChainData {
   std::vector<FrameMotion<Scalar>> motion;
   std::vector<BodyLoad<Scalar>> loads;
   std::vector<Wrench<Scalar>> wrench;
-  VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit, qddot;
+  /// One output field per algorithm (as Pinocchio's data.tau, data.g, data.nle): rnea ->
+  /// tau, gravity -> gravity_forces, bias -> bias_forces, mass_matrix_and_bias and aba ->
+  /// nonlinear_forces (C qdot + G), aba and forward_dynamics -> qddot.
+  VectorQ tau, gravity_forces, bias_forces, nonlinear_forces, qdot_zero, unit, qddot;
   MatrixQ mass_matrix;
   MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
   /// Per-segment scratch of aba (articulated_body.hpp), one per segment.
@@ -141,6 +144,7 @@ struct DynamicChainData {
     tau = VectorQ::Zero(nq);
     gravity_forces = VectorQ::Zero(nq);
     bias_forces = VectorQ::Zero(nq);
+    nonlinear_forces = VectorQ::Zero(nq);
     qdot_zero = VectorQ::Zero(nq);
     unit = VectorQ::Zero(nq);
     qddot = VectorQ::Zero(nq);

@@ -109,7 +109,10 @@ struct ChainData<Chain<Segments...>> {
   std::array<FrameMotion<Scalar>, N + 1> motion;  ///< [0] base, [i+1] distal frame of segment i
   std::array<BodyLoad<Scalar>, N> loads;
   std::array<Wrench<Scalar>, N + 1> wrench;  ///< [i] at the base of segment i, [N] at the tip
-  typename ChainT::VectorQ tau, gravity_forces, bias_forces, qdot_zero, unit, qddot;
+  /// One output field per algorithm (as Pinocchio's data.tau, data.g, data.nle): rnea ->
+  /// tau, gravity -> gravity_forces, bias -> bias_forces, mass_matrix_and_bias and aba ->
+  /// nonlinear_forces (C qdot + G), aba and forward_dynamics -> qddot.
+  typename ChainT::VectorQ tau, gravity_forces, bias_forces, nonlinear_forces, qdot_zero, unit, qddot;
   typename ChainT::MatrixQ mass_matrix;
   typename ChainT::MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
   /// Per-segment scratch of aba (articulated_body.hpp).
@@ -120,6 +123,7 @@ struct ChainData<Chain<Segments...>> {
     tau.setZero();
     gravity_forces.setZero();
     bias_forces.setZero();
+    nonlinear_forces.setZero();
     qdot_zero.setZero();
     unit.setZero();
     qddot.setZero();
