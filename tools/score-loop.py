@@ -228,6 +228,7 @@ def score(res, report):
     inertia = report.get("inertia_model") or {}
     res["inertia"] = f"distributed (round {inertia.get('round')})" if inertia.get("chosen") == "distributed" else "as declared"
     res["removed"] = [e.get("label", e.get("name", "?")) for e in report.get("removed_effects", [])]
+    res["equivalent"] = [l for e in report.get("effects", []) for l in e.get("equivalent", [])]
     b, fin = median_of(report, "baseline", "test"), median_of(report, "final", "test")
     res["test_before"], res["test_after"] = b, fin
     at_floor = fin <= FLOOR_FACTOR * FLOOR
@@ -279,6 +280,8 @@ def render(results, args, excluded):
              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in results:
         found = ", ".join(r.get("found", [])) or ("none" if "found" in r else "-")
+        if r.get("equivalent"):
+            found += " (indistinguishable: " + ", ".join(r["equivalent"]) + ")"
         if r.get("removed"):
             found += " (removed: " + ", ".join(r["removed"]) + ")"
         if "test_before" in r:

@@ -107,6 +107,7 @@ inline nlohmann::ordered_json loop_report_json(const fit::LoopResult& r, bool ha
     x["fold_gains"] = r.added[k].fold_gains;
     x["selection_gain"] = r.added[k].selection_gain;
     x["evidence"] = r.added[k].evidence;
+    x["equivalent"] = r.added[k].equivalent;
     effects.push_back(x);
   }
   j["effects"] = effects;

@@ -51,7 +51,9 @@ namespace softrne::fit {
 
 /// \brief The measured false-positive rate of the significance rule with the default options:
 /// effect-free random arms (tools/score-loop.py, docs/closing-the-loop.md) that got any effect.
-inline constexpr const char* kCalibratedFalsePositiveRate = "not yet measured";
+inline constexpr const char* kCalibratedFalsePositiveRate =
+    "1 of 16 effect-free random arms (6 %) got an effect (tools/score-loop.py, seeds 1000-1025 "
+    "and --controls-only 5000-5009, 2026-12-01; docs/closing-the-loop.md)";
 
 /// \brief Settings of the closed loop.
 struct LoopOptions {
@@ -74,6 +76,9 @@ struct LoopOptions {
   /// lower by at least `inertia_min_gain` in every fold; reported as the joints' inertia
   /// model, never as an effect.
   bool try_distributed_inertia = true;
+  /// Relative difference of the held-out errors (every fold) below which two passing
+  /// candidates with as many parameters are reported as equivalent (AddedEffect::equivalent).
+  double equivalence_tolerance = 0.005;
   double inertia_min_gain = 0.01;
   /// A coordinate whose final median error exceeds this multiple of the noise floor is
   /// reported as unexplained.
@@ -101,6 +106,11 @@ struct AddedEffect {
   std::string evidence;
   std::vector<double> fold_gains;
   double selection_gain = 0;  ///< mean held-out gain in the round it was added
+  /// Candidates that passed in the same round with as many parameters and a held-out error
+  /// within LoopOptions::equivalence_tolerance of this one's in every fold: the data cannot
+  /// tell them apart (a shared mass scale s and a shared chamber gain 1/s are the same model
+  /// once K and D are refitted). Labels; empty when the choice was clear.
+  std::vector<std::string> equivalent;
 };
 
 /// \brief The inertia model of the CC joints the loop chose (LoopOptions::try_distributed_inertia).
@@ -463,6 +473,20 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       a.evidence += (f ? ", " : " ") + detail::percent(w.fold_gains[f]);
     a.evidence += " in the " + std::to_string(w.fold_gains.size()) +
                   " folds against the model without it (fold models fitted on their own training blocks)";
+    for (int r : passing) {
+      if (r == best || n_params(r) != n_params(best)) continue;
+      const CandidateScore& o = scores[static_cast<std::size_t>(r)];
+      bool same = o.fold_gains.size() == w.fold_gains.size();
+      for (std::size_t f = 0; same && f < w.fold_gains.size(); ++f)
+        same = std::abs((1.0 - o.fold_gains[f]) / (1.0 - w.fold_gains[f]) - 1.0) <= opt.equivalence_tolerance;
+      if (same) a.equivalent.push_back(o.label);
+    }
+    if (!a.equivalent.empty()) {
+      std::string alts;
+      for (const auto& l : a.equivalent) alts += (alts.empty() ? "" : ", ") + l;
+      a.evidence += "; the data cannot tell it from " + alts + " (the same held-out error)";
+      log("  indistinguishable from " + alts);
+    }
     out.added.push_back(a);
   }
 
