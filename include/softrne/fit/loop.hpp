@@ -165,14 +165,37 @@ struct Fold {
   double held_rms = std::numeric_limits<double>::infinity();
 };
 
-/// Makes `m` the fold's model: simulates it through the record and measures its held-out
-/// error (infinite if it fails to simulate).
-inline void set_fold_model(Fold& f, ArmDescription m, const io::Dataset& train,
-                           const sim::ArmSimulationOptions& sim_opt) {
-  f.model = std::move(m);
-  f.angles = simulated_angles(f.model, train, sim_opt);
-  f.held_rms = f.angles.size() ? masked_rms(f.angles, train.angles, f.held_rows)
-                               : std::numeric_limits<double>::infinity();
+/// A model refitted on one fold's training blocks and measured on its held-out blocks: the one
+/// way the loop judges any change (a candidate effect, the inertia model, the base model's own
+/// polish, an effect taken out).
+struct FoldTrial {
+  ArmFitResult fit;
+  Eigen::MatrixXd angles;  ///< the refitted model simulated through the whole record; empty on failure
+  double held_rms = std::numeric_limits<double>::infinity();
+  /// Relative drop of the held-out error against the fold's current model (-inf on failure).
+  double gain = -std::numeric_limits<double>::infinity();
+  bool ok() const { return angles.size() > 0 && std::isfinite(held_rms); }
+};
+
+/// Refits `start` on fold `f`'s training blocks with `refit` (its sample mask is replaced)
+/// and measures the held-out error.
+inline FoldTrial try_on_fold(const Fold& f, const ArmDescription& start, const io::Dataset& train,
+                             ArmFitOptions refit, int* simulations) {
+  refit.sample_mask = f.fit_rows;
+  FoldTrial t;
+  t.fit = fit_arm(start, train, refit);
+  t.angles = t.fit.angles;
+  if (simulations) *simulations += t.fit.simulations;
+  if (t.angles.size()) t.held_rms = masked_rms(t.angles, train.angles, f.held_rows);
+  if (t.ok()) t.gain = 1.0 - t.held_rms / f.held_rms;
+  return t;
+}
+
+/// Makes the trial's model the fold's model (its simulation and held-out error come along).
+inline void adopt(Fold& f, const FoldTrial& t) {
+  f.model = t.fit.fitted;
+  f.angles = t.angles;
+  f.held_rms = t.held_rms;
 }
 
 inline std::vector<Fold> make_folds(Eigen::Index N, int blocks) {
@@ -228,8 +251,13 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
 #if SOFTRNE_FIT_BODIES
 {
   const auto t0 = std::chrono::steady_clock::now();
+  // Progress lines carry the elapsed time, so a user sees where a long loop spends it.
   auto log = [&](const std::string& s) {
-    if (opt.log) opt.log(s);
+    if (!opt.log) return;
+    char stamp[32];
+    std::snprintf(stamp, sizeof stamp, "[%6.1f s] ",
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    opt.log(stamp + s);
   };
   check_fit_data(declared, train);
   LoopResult out;
@@ -258,11 +286,8 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   for (std::size_t f = 0; f < folds.size(); ++f) {
     log("fold " + std::to_string(f + 1) + ": base fit on its training blocks");
     ArmFitOptions o = opt.fit;
-    o.sample_mask = folds[f].fit_rows;
     o.optimiser.compute_identifiability = false;
-    const ArmFitResult r = fit_arm(declared, train, o);
-    out.simulations += r.simulations;
-    detail::set_fold_model(folds[f], r.fitted, train, sim_opt);
+    detail::adopt(folds[f], detail::try_on_fold(folds[f], declared, train, o, &out.simulations));
   }
 
   ArmFitOptions refit = opt.fit;
@@ -276,6 +301,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   // A change of the model (an effect in or out, the inertia model) is refitted on all training
   // data from where it stands, with standard errors for the report.
   auto full_refit = [&](const ArmDescription& start) {
+    log("refit on all training data");
     ArmFitOptions full = refit;
     full.optimiser.local_evals = opt.fit.optimiser.local_evals;
     full.optimiser.compute_identifiability = true;
@@ -293,19 +319,10 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     // A fair comparator: each fold's base model gets the same local refit a candidate gets
     // (from where it stands, on its own training blocks), so a candidate cannot earn credit
     // for iterations on K and D that the base model simply had not had.
+    log("round " + std::to_string(round + 1) + ": local refit of the folds' base models");
     for (auto& f : folds) {
-      ArmFitOptions o = refit;
-      o.sample_mask = f.fit_rows;
-      const ArmFitResult polished = fit_arm(f.model, train, o);
-      out.simulations += polished.simulations;
-      const Eigen::MatrixXd y = detail::simulated_angles(polished.fitted, train, sim_opt);
-      const double held = y.size() ? detail::masked_rms(y, train.angles, f.held_rows)
-                                   : std::numeric_limits<double>::infinity();
-      if (y.size() && std::isfinite(held)) {
-        f.model = polished.fitted;
-        f.angles = y;
-        f.held_rms = held;
-      }
+      const detail::FoldTrial polished = detail::try_on_fold(f, f.model, train, refit, &out.simulations);
+      if (polished.ok()) detail::adopt(f, polished);
     }
     // Tried in every round until adopted: a missing effect can hide what the inertia model
     // gains (its error dominates) until that effect is in.
@@ -316,37 +333,23 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       if (out.inertia.tried) {
         // Judged as a candidate is: the same local refit from each fold's (just polished)
         // model, on its own training blocks, against that model's held-out error.
-        std::vector<ArmFitResult> fits;
-        std::vector<Eigen::MatrixXd> ys;
-        std::vector<double> held;
+        std::vector<detail::FoldTrial> trials;
         double worst_gain = std::numeric_limits<double>::infinity();
         std::string line = "  inertia model distributed: held-out error";
         for (const auto& f : folds) {
           ArmDescription m = f.model;
           detail::distribute_cc_inertia(m);
-          ArmFitOptions o = refit;
-          o.sample_mask = f.fit_rows;
-          fits.push_back(fit_arm(m, train, o));
-          out.simulations += fits.back().simulations;
-          ys.push_back(detail::simulated_angles(fits.back().fitted, train, sim_opt));
-          held.push_back(ys.back().size() ? detail::masked_rms(ys.back(), train.angles, f.held_rows)
-                                          : std::numeric_limits<double>::infinity());
-          const double g = std::isfinite(held.back()) ? 1.0 - held.back() / f.held_rms
-                                                      : -std::numeric_limits<double>::infinity();
-          out.inertia.fold_gains.push_back(g);
-          worst_gain = std::min(worst_gain, g);
-          line += " " + detail::percent(g);
+          trials.push_back(detail::try_on_fold(f, m, train, refit, &out.simulations));
+          out.inertia.fold_gains.push_back(trials.back().gain);
+          worst_gain = std::min(worst_gain, trials.back().gain);
+          line += " " + detail::percent(trials.back().gain);
         }
         log(line);
         if (worst_gain >= opt.inertia_min_gain) {
           log("adopting distributed inertia for the CC joints");
           out.inertia.adopted = true;
           out.inertia.round = round + 1;
-          for (std::size_t f = 0; f < folds.size(); ++f) {
-            folds[f].model = fits[f].fitted;
-            folds[f].angles = ys[f];
-            folds[f].held_rms = held[f];
-          }
+          for (std::size_t f = 0; f < folds.size(); ++f) detail::adopt(folds[f], trials[f]);
           full_refit(distributed);
         }
       }
@@ -356,6 +359,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     const std::vector<Candidate> cands =
         expand_secondary_kinds(raw, folds[0].model, folds[0].angles, train, sim_opt, threads, &out.simulations);
     std::vector<std::vector<FoldScreen>> screens;
+    log("round " + std::to_string(round + 1) + ": screening " + std::to_string(cands.size()) + " candidates");
     for (const auto& f : folds)
       screens.push_back(screen_fold(cands, f.model, f.angles, train, f.fit_rows, f.held_rows, sim_opt, threads,
                                     &out.simulations));
@@ -387,47 +391,39 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     log("round " + std::to_string(round + 1) + ": screened " + std::to_string(cands.size()) +
         " candidates (" + std::to_string(scores.size()) + " effect/scope pairs)");
 
-    std::vector<std::vector<ArmFitResult>> fold_fits(scores.size());
+    std::vector<std::vector<detail::FoldTrial>> fold_trials(scores.size());
     std::vector<int> passing;
-    // Refit the best-screened, at most two scopes per effect: models that the screen cannot
-    // tell apart (a Dahl element with a small yield angle is Coulomb friction) must both be
-    // refitted so that the held-out error, and parsimony, choose between them.
-    std::vector<std::string> confirmed_names;
-    int refitted = 0;
-    for (std::size_t r = 0; r < scores.size() && refitted < opt.candidates_to_confirm; ++r) {
+    // Refits candidate r in every fold (from the fold's model and its own screening step) and
+    // measures its held-out gains; it passes if it gains min_gain in every fold.
+    auto confirm = [&](std::size_t r) {
       CandidateScore& s = scores[r];
-      if (worst(score_cand[r]) < opt.min_predicted_gain) break;  // ordered: the rest predict less
-      if (std::count(confirmed_names.begin(), confirmed_names.end(), s.name) >= 2) continue;
-      confirmed_names.push_back(s.name);
-      ++refitted;
       const Candidate& cand = cands[score_cand[r]];
-      std::vector<ArmFitResult> fits;
       s.confirmed = true;
+      double sum = 0, mn = std::numeric_limits<double>::infinity();
       for (std::size_t f = 0; f < folds.size(); ++f) {
         AnyEffect e = cand.effect;
         effect_base(e).params = screens[f][score_cand[r]].start;
-        ArmFitOptions o = refit;
-        o.sample_mask = folds[f].fit_rows;
-        const ArmFitResult fr = fit_arm(detail::with_effect(folds[f].model, e), train, o);
-        out.simulations += fr.simulations;
-        const Eigen::MatrixXd y = detail::simulated_angles(fr.fitted, train, sim_opt);
-        const double held = y.size() ? detail::masked_rms(y, train.angles, folds[f].held_rows)
-                                     : std::numeric_limits<double>::infinity();
-        s.fold_gains.push_back(std::isfinite(held) ? 1.0 - held / folds[f].held_rms
-                                                   : -std::numeric_limits<double>::infinity());
-        fits.push_back(fr);
-      }
-      double sum = 0, mn = std::numeric_limits<double>::infinity();
-      for (double g : s.fold_gains) {
-        sum += g;
-        mn = std::min(mn, g);
+        fold_trials[r].push_back(
+            detail::try_on_fold(folds[f], detail::with_effect(folds[f].model, e), train, refit, &out.simulations));
+        s.fold_gains.push_back(fold_trials[r].back().gain);
+        sum += s.fold_gains.back();
+        mn = std::min(mn, s.fold_gains.back());
       }
       s.cv_gain = sum / static_cast<double>(s.fold_gains.size());
       std::string line = "  " + s.label + ": held-out error";
       for (double g : s.fold_gains) line += " " + detail::percent(g);
       log(line);
-      fold_fits[r] = fits;
       if (mn >= opt.min_gain) passing.push_back(static_cast<int>(r));
+    };
+    // Refit the best-screened, at most two scopes per effect.
+    std::vector<std::string> confirmed_names;
+    int refitted = 0;
+    for (std::size_t r = 0; r < scores.size() && refitted < opt.candidates_to_confirm; ++r) {
+      if (worst(score_cand[r]) < opt.min_predicted_gain) break;  // ordered: the rest predict less
+      if (std::count(confirmed_names.begin(), confirmed_names.end(), scores[r].name) >= 2) continue;
+      confirmed_names.push_back(scores[r].name);
+      ++refitted;
+      confirm(r);
     }
     // The best passing candidate; a simpler one (fewer parameters) wins if its remaining
     // held-out error is within min_gain of the best's, the same margin every effect must earn.
@@ -455,14 +451,13 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     out.rounds.push_back(scores);
     log("adding " + w.label);
     // Full-data refit from the current model with the effect at the mean of the folds' values.
-    const std::vector<ArmFitResult>& best_fold_fits = fold_fits[static_cast<std::size_t>(best)];
+    const std::vector<detail::FoldTrial>& best_trials = fold_trials[static_cast<std::size_t>(best)];
     AnyEffect e = cands[score_cand[static_cast<std::size_t>(best)]].effect;
     Eigen::VectorXd mean = Eigen::VectorXd::Zero(effect_base(e).params.size());
-    for (const auto& fr : best_fold_fits) mean += effect_base(fr.fitted.effects.back()).params;
-    effect_base(e).params = mean / static_cast<double>(best_fold_fits.size());
+    for (const auto& t : best_trials) mean += effect_base(t.fit.fitted.effects.back()).params;
+    effect_base(e).params = mean / static_cast<double>(best_trials.size());
     full_refit(detail::with_effect(current, e));
-    for (std::size_t f = 0; f < folds.size(); ++f)
-      detail::set_fold_model(folds[f], best_fold_fits[f].fitted, train, sim_opt);
+    for (std::size_t f = 0; f < folds.size(); ++f) detail::adopt(folds[f], best_trials[f]);
     AddedEffect a;
     a.effect = e;
     a.label = w.label;
@@ -499,21 +494,17 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     const std::size_t first = current.effects.size() - out.added.size();
     int drop = -1;
     double drop_gain = std::numeric_limits<double>::infinity();
-    std::vector<ArmFitResult> drop_fits;
+    std::vector<detail::FoldTrial> drop_trials;
     std::vector<double> drop_fold_gains;
     for (std::size_t a = 0; a < out.added.size(); ++a) {
-      std::vector<ArmFitResult> fits;
+      std::vector<detail::FoldTrial> trials;
       std::vector<double> gains;
       double worst_gain = std::numeric_limits<double>::infinity();
       for (const auto& f : folds) {
-        ArmFitOptions o = refit;
-        o.sample_mask = f.fit_rows;
-        fits.push_back(fit_arm(detail::without_effect(f.model, first + a), train, o));
-        out.simulations += fits.back().simulations;
-        const Eigen::MatrixXd y = detail::simulated_angles(fits.back().fitted, train, sim_opt);
-        const double held = y.size() ? detail::masked_rms(y, train.angles, f.held_rows)
-                                     : std::numeric_limits<double>::infinity();
-        gains.push_back(1.0 - f.held_rms / held);  // what the effect gains over the model without it
+        trials.push_back(
+            detail::try_on_fold(f, detail::without_effect(f.model, first + a), train, refit, &out.simulations));
+        // What the effect gains over the model without it (all of it if that one fails).
+        gains.push_back(1.0 - f.held_rms / trials.back().held_rms);
         worst_gain = std::min(worst_gain, gains.back());
       }
       std::string line = "  backward: " + out.added[a].label + ": held-out error without it";
@@ -522,7 +513,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       if (worst_gain < opt.min_gain && worst_gain < drop_gain) {
         drop = static_cast<int>(a);
         drop_gain = worst_gain;
-        drop_fits = fits;
+        drop_trials = trials;
         drop_fold_gains = gains;
       }
     }
@@ -539,8 +530,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     gone.evidence += " only (less than min_gain in some fold)";
     out.removed.push_back(gone);
     out.added.erase(out.added.begin() + drop);
-    for (std::size_t f = 0; f < folds.size(); ++f)
-      detail::set_fold_model(folds[f], drop_fits[f].fitted, train, sim_opt);
+    for (std::size_t f = 0; f < folds.size(); ++f) detail::adopt(folds[f], drop_trials[f]);
     full_refit(detail::without_effect(current, first + static_cast<std::size_t>(drop)));
   }
 
@@ -551,8 +541,11 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     const Eigen::MatrixXd y = detail::simulated_angles(d, data, sim_opt);
     return y.size() ? Eigen::MatrixXd(data.angles - y) : Eigen::MatrixXd();
   };
-  out.baseline_residual = residual(out.baseline.fitted, train);
-  out.final_residual = residual(current, train);
+  // The fits' own simulations through every training sample (fit_arm keeps them).
+  out.baseline_residual = out.baseline.angles.size() ? Eigen::MatrixXd(train.angles - out.baseline.angles)
+                                                     : residual(out.baseline.fitted, train);
+  out.final_residual = current_fit.angles.size() ? Eigen::MatrixXd(train.angles - current_fit.angles)
+                                                 : residual(current, train);
   if (out.final_residual.size())
     out.unexplained_train = analyse_residual(current, train.t, train.angles, train.angles - out.final_residual,
                                              train.pressures, out.noise_sigma, opt.unexplained_ratio);
