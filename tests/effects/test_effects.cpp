@@ -560,6 +560,23 @@ TYPED_TEST(EveryEffect, DescribesItself) {
     }
 }
 
+// `reduces_to` (effect_reduces_to) names another effect whose kinds are this one's first
+// kinds (same units) and which allows every scope this one does, so that the loop can refit
+// it in the same scope from the same values.
+TYPED_TEST(EveryEffect, ItsSimplerLimitIsAnEffectWithItsFirstKinds) {
+  using E = TypeParam;
+  const AnyEffect e = E{};
+  const std::string simpler = softrne::effect_reduces_to(e);
+  if (simpler.empty()) return;  // most effects have none; hysteresis has (its own test below)
+  AnyEffect s;
+  ASSERT_TRUE(softrne::make_effect(simpler, s)) << simpler;
+  EXPECT_NE(softrne::effect_name(s), E::name);
+  ASSERT_LT(softrne::effect_num_kinds(s), softrne::effect_num_kinds(e));
+  for (int k = 0; k < softrne::effect_num_kinds(s); ++k)
+    EXPECT_EQ(std::string(softrne::effect_param_info(s, k).unit), softrne::effect_param_info(e, k).unit);
+  for (Scope sc : E::scopes) EXPECT_TRUE(softrne::effect_scope_allowed(s, sc)) << softrne::scope_name(sc);
+}
+
 TYPED_TEST(EveryEffect, ParameterNamesFollowTheRobotFileRules) {
   for (const AnyEffect& e : this->neutral_in_every_scope()) {
     const EffectBase& b = softrne::effect_base(e);
@@ -1132,6 +1149,42 @@ TEST(Hysteresis, ASlowSinusoidTracesALoopThatSaturatesAtFmax) {
                 .cwiseAbs()
                 .maxCoeff(),
             1e-15);
+}
+
+// The limit hysteresis declares (reduces_to = coulomb_friction): with a Dahl stiffness at the
+// top of its range, the force along q = A sin(w t) is Coulomb friction's -Fc tanh(qdot / v_s)
+// with Fc = Fmax, except within a few v_s of the reversals, where the two smoothings differ.
+TEST(Hysteresis, AtItsLargestStiffnessItIsCoulombFriction) {
+  const double f_max = 0.4, A = 0.3, w = 2.0;
+  const double sigma = softrne::Hysteresis::param_info[1].upper;
+  const ArmDescription dh = with_effect(effect("hysteresis", Scope::Shared, {f_max, sigma}));
+  const ArmDescription dc = with_effect(effect("coulomb_friction", Scope::Shared, {f_max}));
+  ArmDynamics<double> fh(dh), fc(dc);
+  const VectorXd p = VectorXd::Zero(dh.num_inputs), pe = p;
+  const double T = 2 * M_PI / w, dt = T / 200000;
+  VectorXd F = VectorXd::Zero(dh.num_effect_states);
+  auto Fdot = [&](double t, const VectorXd& x) {
+    const VectorXd q = VectorXd::Constant(dh.nq, A * std::sin(w * t));
+    const VectorXd qd = VectorXd::Constant(dh.nq, A * w * std::cos(w * t));
+    VectorXd r(x.size());
+    fh.effect_state_derivative(x, q, qd, p, r);
+    return r;
+  };
+  double worst = 0, near_reversal = 0;
+  for (int i = 0; i < 400000; ++i) {  // two periods, the second one checked
+    const double t = i * dt;
+    const VectorXd k1 = Fdot(t, F), k2 = Fdot(t + dt / 2, F + dt / 2 * k1),
+                   k3 = Fdot(t + dt / 2, F + dt / 2 * k2), k4 = Fdot(t + dt, F + dt * k3);
+    F += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    if (i < 200000) continue;
+    const VectorXd q = VectorXd::Constant(dh.nq, A * std::sin(w * (t + dt)));
+    const VectorXd qd = VectorXd::Constant(dh.nq, A * w * std::cos(w * (t + dt)));
+    const double diff = (fh.joint_forces(q, qd, pe, F) - fc.joint_forces(q, qd, pe, VectorXd())).cwiseAbs().maxCoeff();
+    if (std::abs(qd(0)) > 5 * softrne::CoulombFriction::kSmoothingSpeed) worst = std::max(worst, diff);
+    else near_reversal = std::max(near_reversal, diff);
+  }
+  EXPECT_LT(worst, 1e-3 * f_max);
+  EXPECT_GT(near_reversal, 0.1 * f_max);  // the comparison did cross the reversals
 }
 
 TEST(RobotFile, ParameterNamesAreCheckedWhenRead) {

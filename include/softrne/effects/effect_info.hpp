@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -32,6 +33,27 @@ inline bool effect_scope_allowed(const AnyEffect& e, Scope s) {
 /// \brief Whether the effect can act on joint j (e.g. pressure effects need chambers).
 inline bool effect_applies_to(const AnyEffect& e, const ArmJoint& j) {
   return std::visit([&](const auto& x) { return std::decay_t<decltype(x)>::applies_to(j); }, e);
+}
+
+namespace detail {
+template <class E, class = void>
+struct HasReducesTo : std::false_type {};
+template <class E>
+struct HasReducesTo<E, std::void_t<decltype(E::reduces_to)>> : std::true_type {};
+}  // namespace detail
+
+/// \brief The name of the simpler effect this one contains as a limit (its header's
+/// `reduces_to`: the simpler effect's kinds are this one's first kinds, the others go to a
+/// limit), or "" if none. The closed loop refits the simpler one beside it, so parsimony can
+/// choose.
+inline std::string effect_reduces_to(const AnyEffect& e) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using E = std::decay_t<decltype(x)>;
+        if constexpr (detail::HasReducesTo<E>::value) return E::reduces_to;
+        else return {};
+      },
+      e);
 }
 
 /// \brief Number of parameter kinds per unit (2 for viscoelastic: k and tau).

@@ -33,6 +33,12 @@ struct Hysteresis : Effect<Hysteresis> {
                                                Scope::PerCoordinate};
   static bool applies_to(const ArmJoint&) { return true; }
   static constexpr double kSmoothingSpeed = 1e-4;
+  /// As sigma grows, F reaches +-Fmax within a vanishing angle after each reversal: the
+  /// element becomes Coulomb friction with Fc = Fmax (kind 0 of both). Data from Coulomb
+  /// friction are fitted by a stiff Dahl element about as well, so the loop refits
+  /// coulomb_friction beside it and keeps the simpler one unless the Dahl stiffness earns
+  /// its parameter (effect_reduces_to).
+  static constexpr const char* reduces_to = "coulomb_friction";
 
   int num_states(const std::vector<ArmJoint>& arm) const {
     int n = 0;

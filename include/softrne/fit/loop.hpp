@@ -425,6 +425,24 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       ++refitted;
       confirm(r);
     }
+    // A passing effect that contains a simpler one as a limit (a Dahl element with a large
+    // stiffness is Coulomb friction: the effect header's `reduces_to`) has the simpler one,
+    // in the same scope, refitted too, wherever the screen ranked it: the screen cannot tell
+    // the two apart, the held-out error and parsimony below can.
+    for (std::size_t k = 0; k < passing.size(); ++k) {
+      const AnyEffect& e = cands[score_cand[static_cast<std::size_t>(passing[k])]].effect;
+      const std::string simpler = effect_reduces_to(e);
+      if (simpler.empty()) continue;
+      for (std::size_t r = 0; r < scores.size(); ++r) {
+        const AnyEffect& o = cands[score_cand[r]].effect;
+        if (scores[r].confirmed || scores[r].name != simpler || effect_base(o).scope != effect_base(e).scope ||
+            effect_base(o).joints != effect_base(e).joints)
+          continue;
+        log("  refitting " + scores[r].label + ", the simpler limit of " + scores[static_cast<std::size_t>(passing[k])].label);
+        confirm(r);
+        break;
+      }
+    }
     // The best passing candidate; a simpler one (fewer parameters) wins if its remaining
     // held-out error is within min_gain of the best's, the same margin every effect must earn.
     int best = -1;
