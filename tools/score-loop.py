@@ -124,6 +124,19 @@ def read_found(report):
     return found
 
 
+def read_equivalents(report):
+    """Per reported effect, its indistinguishable alternatives as (name, scope, joints, [])."""
+    out = []
+    for item in report.get("effects") or []:
+        alts = []
+        for label in (item.get("equivalent") or []) if isinstance(item, dict) else []:
+            m = re.match(r"^(\w+) \((shared|joint|coordinate|chamber)((?: [^ )]+)*)\)", label)
+            if m:
+                alts.append((m.group(1), m.group(2), m.group(3).split(), []))
+        out.append(alts)
+    return out
+
+
 def median_of(report, which, part):
     try:
         return float(report[which][part]["median"])
@@ -177,9 +190,10 @@ def rescore_case(args, seed, effects):
 
 
 def run_case(args, seed, effects, tools):
-    if args.rescore:
-        return rescore_case(args, seed, effects)
     d = os.path.join(args.work, f"case{seed}")
+    done = all(os.path.exists(os.path.join(d, f)) for f in ("report.json", "loop.seconds", "case.json"))
+    if args.rescore or (args.resume and done):
+        return rescore_case(args, seed, effects)
     os.makedirs(d, exist_ok=True)
     res = {"seed": seed, "requested": [f"{e}:{s}" for e, s in effects], "dir": d}
     cmd = [tools["make"], "--seed", str(seed), "--out", d, "--quiet"]
@@ -239,13 +253,33 @@ def score(res, report):
         res["names_right"] = res["scopes_right"] = not found
         res["verdict"] = "ok" if not found and not harm else ("false positive" if found else "harm")
         return
-    names_right = sorted(e["name"] for e in inj) == sorted(f[0] for f in found)
-    matched = sum(1 for e in inj if any(effect_matches(e, f, res.get("cc_joints", [])) for f in found))
-    scopes_right = names_right and matched == len(inj)
+    cc = res.get("cc_joints", [])
+
+    def judge(found):
+        names_right = sorted(e["name"] for e in inj) == sorted(f[0] for f in found)
+        matched = sum(1 for e in inj if any(effect_matches(e, f, cc) for f in found))
+        return names_right, names_right and matched == len(inj)
+
+    names_right, scopes_right = judge(found)
+    # The report may say that the data cannot tell a found effect from another one (a shared
+    # mass scale s is a shared chamber gain 1/s once K and D are refitted): substituting such a
+    # stated alternative for a found effect is scored separately ("right up to an equivalence").
+    equivalent_right = False
+    if not scopes_right:
+        swapped = list(found)
+        for i, alts in enumerate(read_equivalents(report)):
+            if i < len(swapped) and not any(effect_matches(e, swapped[i], cc) for e in inj):
+                for a in alts:
+                    if any(effect_matches(e, a, cc) for e in inj):
+                        swapped[i] = a
+                        break
+        equivalent_right = judge(swapped)[1]
     res["names_right"], res["scopes_right"] = names_right, scopes_right
     named = sum(1 for e in inj if any(f[0] == e["name"] for f in found))
     if scopes_right and (halved or at_floor) and not harm:
         v = "right"
+    elif equivalent_right and (halved or at_floor) and not harm:
+        v = "right up to an equivalence"
     elif scopes_right:
         v = "right, test not improved" if not harm else "right, harms test"
     elif names_right:
@@ -302,6 +336,7 @@ def render(results, args, excluded):
         "scored": len(scored),
         "failed": len(results) - len(scored),
         "effect_cases_right": sum(r["verdict"] == "right" for r in eff),
+        "effect_cases_right_up_to_equivalence": sum(r["verdict"] == "right up to an equivalence" for r in eff),
         "effect_cases_names_right": sum(bool(r.get("names_right")) for r in eff),
         "effect_cases_scopes_right": sum(bool(r.get("scopes_right")) for r in eff),
         "effect_cases": len(eff),
@@ -326,6 +361,8 @@ def render(results, args, excluded):
     lines += ["", "## Summary", "",
               f"- cases: {s['cases']} ({s['scored']} scored, {s['failed']} failed to generate or run)",
               f"- effect cases right (names, scopes, test halved or at floor, no harm): {pct(s['effect_cases_right'], s['effect_cases'])}",
+              f"- and right once an alternative the report calls indistinguishable is taken for the found effect: "
+              f"{pct(s['effect_cases_right_up_to_equivalence'], s['effect_cases'])}",
               f"- effect names right: {pct(s['effect_cases_names_right'], s['effect_cases'])}; names and scopes: "
               f"{pct(s['effect_cases_scopes_right'], s['effect_cases'])}",
               f"- test median halved or at the noise floor (<= {FLOOR_FACTOR * FLOOR:.5f} rad): "
@@ -360,6 +397,9 @@ def main():
                     help="effect-free cases only (calibrates the false-positive rate)")
     ap.add_argument("--rescore", action="store_true",
                     help="do not run anything: score the cases already in WORK again (e.g. after a scoring change)")
+    ap.add_argument("--resume", action="store_true",
+                    help="score cases whose report is already in WORK from it and run only the others "
+                         "(delete a case folder to run it again)")
     ap.add_argument("--loop-arg", action="append", default=[], help="extra argument for softrne-loop (repeatable)")
     args = ap.parse_args()
     if args.cases < 1:
