@@ -157,28 +157,7 @@ class ArmSystem {
   /// \param t, pressures the recorded samples (N, N x num_inputs)
   /// \param mode PCHIP (C1, no overshoot), linear, or zero-order hold between samples
   ArmSystem(const ArmDescription& desc, const Eigen::VectorXd& t, const Eigen::MatrixXd& pressures,
-            ArmSimulationOptions::PressureInterpolation mode)
-      : desc_(desc),
-        f_(desc),
-        f_ad_(desc),
-        mode_(mode),
-        input_(t, pressures,
-               mode == ArmSimulationOptions::PressureInterpolation::zero_order_hold
-                   ? Interpolation::zero_order_hold
-                   : Interpolation::linear),
-        pchip_(t, pressures),
-        delay_(desc.input_delay()) {
-    const int nq = desc.nq, ns = desc.num_states();
-    p_.resize(desc.num_inputs);
-    x_ad_.resize(ns);
-    xd_ad_.resize(ns);
-    q_ad_.resize(nq);
-    v_ad_.resize(nq);
-    a_ad_.resize(nq);
-    p_ad_.resize(desc.num_inputs);
-    xdot_.resize(ns);
-    dr_.resize(nq, kBlock);
-  }
+            ArmSimulationOptions::PressureInterpolation mode);
 
   int size() const { return desc_.num_states(); }
   const ArmDescription& description() const { return desc_; }
@@ -206,80 +185,18 @@ class ArmSystem {
   /// The transport delay the system applies to the recorded pressures (s).
   double input_delay() const { return delay_; }
 
-  bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> xdot) {
-    if (progress_ && (++rhs_calls_ & 63u) == 0) (*progress_)(t);
-    pressures(t);
-    f_.rhs(x, p_, xdot);
-    return xdot.allFinite();
-  }
+  /// x' = f(t, x) (eq. 23 with the effects); false if it is not finite.
+  bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> xdot);
 
+  /// The exact Jacobian df/dx by AutoDiff (JacobianMethod); false if it is not finite.
   bool jacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J) {
-    pressures(t);
-    if (method_ == JacobianMethod::forward_dynamics) return jacobian_forward(x, J);
-    return jacobian_inverse(x, J);
-  }
+                const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J);
 
  private:
   // Seeds x_ad_ with the value x and unit derivatives for states [start, start + kBlock).
-  void seed(const Eigen::Ref<const Eigen::VectorXd>& x, int start) {
-    const int n = size();
-    for (int i = 0; i < n; ++i) {
-      x_ad_(i).value() = x(i);
-      x_ad_(i).derivatives().setZero();
-      if (i >= start && i < start + kBlock) x_ad_(i).derivatives()(i - start) = 1.0;
-    }
-  }
-
-  bool jacobian_forward(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J) {
-    const int n = size();
-    for (int start = 0; start < n; start += kBlock) {
-      seed(x, start);
-      f_ad_.rhs(x_ad_, p_, xd_ad_);
-      for (int i = 0; i < n; ++i)
-        for (int k = 0; k < kBlock && start + k < n; ++k)
-          J(i, start + k) = xd_ad_(i).derivatives()(k);
-    }
-    return J.allFinite();
-  }
-
-  bool jacobian_inverse(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J) {
-    const ArmDescription& d = desc_;
-    const int nq = d.nq, n = size(), nz = d.num_effect_states;
-    // Double evaluation: the acceleration qddot* and M's Cholesky factor at x.
-    f_.rhs(x, p_, xdot_);
-    if (!xdot_.allFinite()) return false;
-    const Eigen::MatrixXd& L = f_.data().mass_factor;  // Cholesky factor in the lower triangle
-    const auto& qdd = f_.data().qddot;
-    for (int i = 0; i < nq; ++i) {
-      a_ad_(i).value() = qdd(i);
-      a_ad_(i).derivatives().setZero();
-    }
-    // d qdot / d qdot = I; d qdot / d (q, z) = 0 (J arrives zeroed from CVODE; not from tests).
-    J.topRows(nq).setZero();
-    J.block(0, nq, nq, nq).setIdentity();
-    for (int start = 0; start < n; start += kBlock) {
-      const int cols = std::min(kBlock, n - start);
-      seed(x, start);
-      q_ad_ = x_ad_.head(nq);
-      v_ad_ = x_ad_.segment(nq, nq);
-      const auto xs = x_ad_.segment(2 * nq, nz);
-      f_ad_.effective_pressures(xs, p_, p_ad_);
-      const auto& tau = f_ad_.joint_forces(q_ad_, v_ad_, p_ad_, xs);
-      const auto& id = rnea(f_ad_.chain(), f_ad_.data(), q_ad_, v_ad_, a_ad_);
-      for (int i = 0; i < nq; ++i)
-        for (int k = 0; k < kBlock; ++k)
-          dr_(i, k) = tau(i).derivatives()(k) - id(i).derivatives()(k);
-      L.triangularView<Eigen::Lower>().solveInPlace(dr_);
-      L.transpose().triangularView<Eigen::Upper>().solveInPlace(dr_);
-      J.block(nq, start, nq, cols) = dr_.leftCols(cols);
-      // Effect states: differentiate their own derivative (it may depend on q and qdot).
-      f_ad_.effect_state_derivative(xs, q_ad_, v_ad_, p_, xd_ad_.segment(2 * nq, nz));
-      for (int i = 2 * nq; i < n; ++i)
-        for (int k = 0; k < cols; ++k) J(i, start + k) = xd_ad_(i).derivatives()(k);
-    }
-    return J.allFinite();
-  }
+  void seed(const Eigen::Ref<const Eigen::VectorXd>& x, int start);
+  bool jacobian_forward(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J);
+  bool jacobian_inverse(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J);
 
   const ArmDescription& desc_;
   ArmDynamics<double> f_;
@@ -298,6 +215,113 @@ class ArmSystem {
   const std::function<void(double)>* progress_ = nullptr;
   unsigned rhs_calls_ = 0;
 };
+
+#if SOFTRNE_SIM_BODIES
+// ArmSystem's members that run the dynamics (double and AutoDiff): compiled once in src/sim.cpp
+// for the targets that link softrne::sim_compiled, inline otherwise (config.hpp). Defined in
+// the class, they were instantiated in every translation unit that included this header.
+SOFTRNE_SIM_INLINE ArmSystem::ArmSystem(const ArmDescription& desc, const Eigen::VectorXd& t,
+                                        const Eigen::MatrixXd& pressures,
+                                        ArmSimulationOptions::PressureInterpolation mode)
+    : desc_(desc),
+      f_(desc),
+      f_ad_(desc),
+      mode_(mode),
+      input_(t, pressures,
+             mode == ArmSimulationOptions::PressureInterpolation::zero_order_hold
+                 ? Interpolation::zero_order_hold
+                 : Interpolation::linear),
+      pchip_(t, pressures),
+      delay_(desc.input_delay()) {
+  const int nq = desc.nq, ns = desc.num_states();
+  p_.resize(desc.num_inputs);
+  x_ad_.resize(ns);
+  xd_ad_.resize(ns);
+  q_ad_.resize(nq);
+  v_ad_.resize(nq);
+  a_ad_.resize(nq);
+  p_ad_.resize(desc.num_inputs);
+  xdot_.resize(ns);
+  dr_.resize(nq, kBlock);
+}
+
+SOFTRNE_SIM_INLINE bool ArmSystem::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
+                                        Eigen::Ref<Eigen::VectorXd> xdot) {
+  if (progress_ && (++rhs_calls_ & 63u) == 0) (*progress_)(t);
+  pressures(t);
+  f_.rhs(x, p_, xdot);
+  return xdot.allFinite();
+}
+
+SOFTRNE_SIM_INLINE bool ArmSystem::jacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
+                                             const Eigen::Ref<const Eigen::VectorXd>&,
+                                             Eigen::Ref<Eigen::MatrixXd> J) {
+  pressures(t);
+  if (method_ == JacobianMethod::forward_dynamics) return jacobian_forward(x, J);
+  return jacobian_inverse(x, J);
+}
+
+SOFTRNE_SIM_INLINE void ArmSystem::seed(const Eigen::Ref<const Eigen::VectorXd>& x, int start) {
+  const int n = size();
+  for (int i = 0; i < n; ++i) {
+    x_ad_(i).value() = x(i);
+    x_ad_(i).derivatives().setZero();
+    if (i >= start && i < start + kBlock) x_ad_(i).derivatives()(i - start) = 1.0;
+  }
+}
+
+SOFTRNE_SIM_INLINE bool ArmSystem::jacobian_forward(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                                     Eigen::Ref<Eigen::MatrixXd> J) {
+  const int n = size();
+  for (int start = 0; start < n; start += kBlock) {
+    seed(x, start);
+    f_ad_.rhs(x_ad_, p_, xd_ad_);
+    for (int i = 0; i < n; ++i)
+      for (int k = 0; k < kBlock && start + k < n; ++k)
+        J(i, start + k) = xd_ad_(i).derivatives()(k);
+  }
+  return J.allFinite();
+}
+
+SOFTRNE_SIM_INLINE bool ArmSystem::jacobian_inverse(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                                     Eigen::Ref<Eigen::MatrixXd> J) {
+  const ArmDescription& d = desc_;
+  const int nq = d.nq, n = size(), nz = d.num_effect_states;
+  // Double evaluation: the acceleration qddot* and M's Cholesky factor at x.
+  f_.rhs(x, p_, xdot_);
+  if (!xdot_.allFinite()) return false;
+  const Eigen::MatrixXd& L = f_.data().mass_factor;  // Cholesky factor in the lower triangle
+  const auto& qdd = f_.data().qddot;
+  for (int i = 0; i < nq; ++i) {
+    a_ad_(i).value() = qdd(i);
+    a_ad_(i).derivatives().setZero();
+  }
+  // d qdot / d qdot = I; d qdot / d (q, z) = 0 (J arrives zeroed from CVODE; not from tests).
+  J.topRows(nq).setZero();
+  J.block(0, nq, nq, nq).setIdentity();
+  for (int start = 0; start < n; start += kBlock) {
+    const int cols = std::min(kBlock, n - start);
+    seed(x, start);
+    q_ad_ = x_ad_.head(nq);
+    v_ad_ = x_ad_.segment(nq, nq);
+    const auto xs = x_ad_.segment(2 * nq, nz);
+    f_ad_.effective_pressures(xs, p_, p_ad_);
+    const auto& tau = f_ad_.joint_forces(q_ad_, v_ad_, p_ad_, xs);
+    const auto& id = rnea(f_ad_.chain(), f_ad_.data(), q_ad_, v_ad_, a_ad_);
+    for (int i = 0; i < nq; ++i)
+      for (int k = 0; k < kBlock; ++k)
+        dr_(i, k) = tau(i).derivatives()(k) - id(i).derivatives()(k);
+    L.triangularView<Eigen::Lower>().solveInPlace(dr_);
+    L.transpose().triangularView<Eigen::Upper>().solveInPlace(dr_);
+    J.block(nq, start, nq, cols) = dr_.leftCols(cols);
+    // Effect states: differentiate their own derivative (it may depend on q and qdot).
+    f_ad_.effect_state_derivative(xs, q_ad_, v_ad_, p_, xd_ad_.segment(2 * nq, nz));
+    for (int i = 2 * nq; i < n; ++i)
+      for (int k = 0; k < cols; ++k) J(i, start + k) = xd_ad_(i).derivatives()(k);
+  }
+  return J.allFinite();
+}
+#endif  // SOFTRNE_SIM_BODIES
 
 namespace detail {
 
