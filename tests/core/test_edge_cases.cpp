@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -306,43 +307,78 @@ TEST(EdgeCases, StaticChainBeyondPiAgreesWithRuntimeChain) {
   EXPECT_LT((tau - tau_dyn).norm(), 1e-12 * tau.norm());
 }
 
-// --- debug-build checks of API misuse (SOFTRNE_ASSERT aborts with a message) ------------
+// --- misuse of a runtime chain: always-on checks (std::invalid_argument), also in Release --
 
-#ifndef NDEBUG
-TEST(EdgeCasesDeathTest, DataOfAnotherRuntimeChainAborts) {
-  GTEST_FLAG_SET(death_test_style, "threadsafe");
+// The message of `f()`'s std::invalid_argument (fails the test if it throws nothing).
+template <class F>
+std::string invalid_argument_message(F&& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no std::invalid_argument";
+  return {};
+}
+
+void expect_contains(const std::string& message, const std::string& part) {
+  EXPECT_NE(message.find(part), std::string::npos) << message;
+}
+
+TEST(EdgeCasesMisuse, DataOfAnotherRuntimeChainThrows) {
   const auto arm = hybrid_arm();
   DynamicChain<double> small;
   small.add(make_cc());
   small.add(make_link());
   auto other = small.make_data();
   const VectorXd z = VectorXd::Zero(arm.num_coordinates());
-  EXPECT_DEATH((void)softrne::rnea(arm, other, z, z, z), "this Data was made for another chain");
-  EXPECT_DEATH((void)softrne::mass_matrix(arm, other, z), "this Data was made for another chain");
-  EXPECT_DEATH((void)softrne::gravity(arm, other, z), "this Data was made for another chain");
-  EXPECT_DEATH((void)softrne::bias(arm, other, z, z), "this Data was made for another chain");
+  const std::string expected = "this Data was made for another chain";
+  expect_contains(invalid_argument_message([&] { (void)softrne::rnea(arm, other, z, z, z); }), expected);
+  expect_contains(invalid_argument_message([&] { (void)softrne::mass_matrix(arm, other, z); }), expected);
+  expect_contains(invalid_argument_message([&] { (void)softrne::gravity(arm, other, z); }), expected);
+  expect_contains(invalid_argument_message([&] { (void)softrne::bias(arm, other, z, z); }), expected);
+  expect_contains(invalid_argument_message([&] { (void)softrne::aba(arm, other, z, z, z); }), expected);
   DynamicChain<double>::Data empty;
-  EXPECT_DEATH((void)softrne::rnea(arm, empty, z, z, z), "this Data was made for another chain");
+  expect_contains(invalid_argument_message([&] { (void)softrne::rnea(arm, empty, z, z, z); }), expected);
 }
 
-TEST(EdgeCasesDeathTest, WrongVectorSizesToRneaAbort) {
-  GTEST_FLAG_SET(death_test_style, "threadsafe");
+// The message names the algorithm, the argument and both sizes, and nothing is read out of
+// bounds (this test runs in the Release build and under the sanitizers).
+TEST(EdgeCasesMisuse, WrongVectorSizesThrowNamingTheArgumentAndBothSizes) {
   const auto arm = hybrid_arm();
   auto data = arm.make_data();
-  const VectorXd z = VectorXd::Zero(arm.num_coordinates());
-  const VectorXd shorter = VectorXd::Zero(arm.num_coordinates() - 1);
-  const VectorXd longer = VectorXd::Zero(arm.num_coordinates() + 1);
-  EXPECT_DEATH((void)softrne::rnea(arm, data, shorter, z, z), "q and qdot must have");
-  EXPECT_DEATH((void)softrne::rnea(arm, data, z, longer, z), "q and qdot must have");
-  EXPECT_DEATH((void)softrne::rnea(arm, data, z, z, shorter), "qddot must have");
-  EXPECT_DEATH((void)softrne::mass_matrix(arm, data, longer), "q and qdot must have");
-  EXPECT_DEATH((void)softrne::bias(arm, data, z, VectorXd()), "q and qdot must have");
+  const int n = arm.num_coordinates();
+  const VectorXd z = VectorXd::Zero(n);
+  const VectorXd shorter = VectorXd::Zero(n - 1);
+  const VectorXd longer = VectorXd::Zero(n + 1);
+  const std::string has = " coordinates", sizes_short = std::to_string(n - 1) + " entries; the chain has " +
+                                                          std::to_string(n) + has,
+                    sizes_long = std::to_string(n + 1) + " entries; the chain has " + std::to_string(n) + has;
+  EXPECT_EQ(invalid_argument_message([&] { (void)softrne::rnea(arm, data, shorter, z, z); }),
+            "softrne::rnea: q has " + sizes_short);
+  EXPECT_EQ(invalid_argument_message([&] { (void)softrne::rnea(arm, data, z, longer, z); }),
+            "softrne::rnea: qdot has " + sizes_long);
+  EXPECT_EQ(invalid_argument_message([&] { (void)softrne::rnea(arm, data, z, z, shorter); }),
+            "softrne::rnea: qddot has " + sizes_short);
+  EXPECT_EQ(invalid_argument_message([&] { (void)softrne::mass_matrix(arm, data, longer); }),
+            "softrne::mass_matrix: q has " + sizes_long);
+  EXPECT_EQ(invalid_argument_message([&] { (void)softrne::gravity(arm, data, shorter); }),
+            "softrne::gravity: q has " + sizes_short);
+  EXPECT_EQ(invalid_argument_message([&] { (void)softrne::bias(arm, data, z, VectorXd()); }),
+            "softrne::bias: qdot has 0 entries; the chain has " + std::to_string(n) + has);
+  EXPECT_EQ(invalid_argument_message([&] { (void)softrne::forward_dynamics(arm, data, z, z, longer); }),
+            "softrne::forward_dynamics: tau has " + sizes_long);
+  EXPECT_EQ(invalid_argument_message([&] { (void)softrne::aba(arm, data, z, shorter, z); }),
+            "softrne::aba: qdot has " + sizes_short);
+  EXPECT_EQ(invalid_argument_message([&] { softrne::compute_kinematics(arm, data, longer, z); }),
+            "softrne::compute_kinematics: q has " + sizes_long);
+  // After a refused call the chain and its Data still work.
+  EXPECT_TRUE(softrne::rnea(arm, data, z, z, z).allFinite());
 }
 
 // A Data of a chain with the same number of segments and coordinates but other segment
 // types passes the size checks; the traversal then finds kinematics of another type.
-TEST(EdgeCasesDeathTest, DataOfSameSizedChainWithOtherSegmentsDoesNotComputeSilently) {
-  GTEST_FLAG_SET(death_test_style, "threadsafe");
+TEST(EdgeCasesMisuse, DataOfSameSizedChainWithOtherSegmentsThrows) {
   DynamicChain<double> a, b;
   a.add(make_cc());
   a.add(make_link());
@@ -350,9 +386,8 @@ TEST(EdgeCasesDeathTest, DataOfSameSizedChainWithOtherSegmentsDoesNotComputeSile
   b.add(make_cc());
   auto data_b = b.make_data();
   const VectorXd z = VectorXd::Zero(2);
-  EXPECT_DEATH((void)softrne::rnea(a, data_b, z, z, z),
-               "this Data was made for another chain \\(segment types differ");
+  expect_contains(invalid_argument_message([&] { (void)softrne::rnea(a, data_b, z, z, z); }),
+                  "this Data was made for another chain (segment 0 has another type");
 }
-#endif
 
 }  // namespace

@@ -306,8 +306,9 @@ const typename ChainT::VectorQ& aba(const ChainT& chain, typename ChainT::Data& 
                                     const Eigen::MatrixBase<Q>& q,
                                     const Eigen::MatrixBase<Qd>& qdot,
                                     const Eigen::MatrixBase<Tau>& tau) {
-  SOFTRNE_ASSERT(tau.size() == chain.num_coordinates(),
-                 "aba: tau must have num_coordinates() entries");
+  detail::check_argument(chain, "aba", "q", q);
+  detail::check_argument(chain, "aba", "qdot", qdot);
+  detail::check_argument(chain, "aba", "tau", tau);
   compute_kinematics(chain, data, q, qdot);
   data.qdot_zero.setZero();
   detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);

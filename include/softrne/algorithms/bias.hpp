@@ -13,6 +13,7 @@ namespace softrne {
 template <class ChainT, class Q>
 const typename ChainT::VectorQ& gravity(const ChainT& chain, typename ChainT::Data& data,
                                         const Eigen::MatrixBase<Q>& q) {
+  detail::check_argument(chain, "gravity", "q", q);
   data.qdot_zero.setZero();
   compute_kinematics(chain, data, q, data.qdot_zero);
   detail::rnea_passes(chain, data, data.qdot_zero, data.qdot_zero, true, false,
@@ -26,6 +27,8 @@ template <class ChainT, class Q, class Qd>
 const typename ChainT::VectorQ& bias(const ChainT& chain, typename ChainT::Data& data,
                                      const Eigen::MatrixBase<Q>& q,
                                      const Eigen::MatrixBase<Qd>& qdot, bool with_gravity = false) {
+  detail::check_argument(chain, "bias", "q", q);
+  detail::check_argument(chain, "bias", "qdot", qdot);
   compute_kinematics(chain, data, q, qdot);
   data.qdot_zero.setZero();
   detail::rnea_passes(chain, data, qdot, data.qdot_zero, with_gravity, true, data.bias_forces);

@@ -62,6 +62,9 @@ const typename ChainT::VectorQ& forward_dynamics(const ChainT& chain, typename C
                                                  const Eigen::MatrixBase<Q>& q,
                                                  const Eigen::MatrixBase<Qd>& qdot,
                                                  const Eigen::MatrixBase<Tau>& tau) {
+  detail::check_argument(chain, "forward_dynamics", "q", q);
+  detail::check_argument(chain, "forward_dynamics", "qdot", qdot);
+  detail::check_argument(chain, "forward_dynamics", "tau", tau);
   mass_matrix_and_bias(chain, data, q, qdot);
   data.qddot = tau - data.nonlinear_forces;
   data.mass_factor = data.mass_matrix;

@@ -10,6 +10,23 @@
 
 namespace softrne {
 
+namespace detail {
+
+/// Checks that argument `v` of `algorithm` has one entry per coordinate of the chain: at
+/// compile time where both sizes are fixed, else by the chain (always on for DynamicChain,
+/// debug only for Chain<...>; see their check_argument).
+template <class ChainT, class V>
+void check_argument(const ChainT& chain, const char* algorithm, const char* argument,
+                    const Eigen::MatrixBase<V>& v) {
+  constexpr int fixed = V::SizeAtCompileTime, chain_fixed = ChainT::VectorQ::SizeAtCompileTime;
+  static_assert(fixed == Eigen::Dynamic || chain_fixed == Eigen::Dynamic || fixed == chain_fixed,
+                "softrne: a fixed-size argument has another size than the chain's nq");
+  if constexpr (fixed == Eigen::Dynamic || chain_fixed == Eigen::Dynamic)
+    chain.check_argument(algorithm, argument, v.size());
+}
+
+}  // namespace detail
+
 /// \brief Calls every segment's `calc(q, qdot)`: rotations, positions, Jacobians, their rates
 /// and inertias (paper section III-A). The other algorithms run on what this leaves in data.
 template <class ChainT, class Q, class Qd>
@@ -17,10 +34,9 @@ void compute_kinematics(const ChainT& chain, typename ChainT::Data& data,
                         const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot) {
   // The Data first: mass_matrix and gravity pass the Data's own zero velocity as qdot, so a
   // Data of another chain would otherwise show up as a wrong-size qdot.
-  SOFTRNE_ASSERT(data.tau.size() == chain.num_coordinates(),
-                 "this Data was made for another chain (call chain.make_data())");
-  SOFTRNE_ASSERT(q.size() == chain.num_coordinates() && qdot.size() == chain.num_coordinates(),
-                 "compute_kinematics: q and qdot must have num_coordinates() entries");
+  chain.check_data(data);
+  detail::check_argument(chain, "compute_kinematics", "q", q);
+  detail::check_argument(chain, "compute_kinematics", "qdot", qdot);
   chain.forward(data, [&](const auto& seg, auto& kin, int, int offset) {
     constexpr int n = std::decay_t<decltype(seg)>::nq;
     seg.calc(q.template segment<n>(offset), qdot.template segment<n>(offset), kin);

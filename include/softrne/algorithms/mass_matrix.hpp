@@ -244,6 +244,7 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
 template <class ChainT, class Q>
 const typename ChainT::MatrixQ& mass_matrix(const ChainT& chain, typename ChainT::Data& data,
                                             const Eigen::MatrixBase<Q>& q) {
+  detail::check_argument(chain, "mass_matrix", "q", q);
   data.qdot_zero.setZero();
   compute_kinematics(chain, data, q, data.qdot_zero);
   detail::mass_matrix_passes(chain, data);
@@ -255,6 +256,8 @@ const typename ChainT::MatrixQ& mass_matrix(const ChainT& chain, typename ChainT
 template <class ChainT, class Q, class Qd>
 void mass_matrix_and_bias(const ChainT& chain, typename ChainT::Data& data,
                           const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot) {
+  detail::check_argument(chain, "mass_matrix_and_bias", "q", q);
+  detail::check_argument(chain, "mass_matrix_and_bias", "qdot", qdot);
   compute_kinematics(chain, data, q, qdot);
   data.qdot_zero.setZero();
   detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);

@@ -54,8 +54,9 @@ const typename ChainT::VectorQ& rnea(const ChainT& chain, typename ChainT::Data&
                                      const Eigen::MatrixBase<Q>& q,
                                      const Eigen::MatrixBase<Qd>& qdot,
                                      const Eigen::MatrixBase<Qdd>& qddot) {
-  SOFTRNE_ASSERT(qddot.size() == chain.num_coordinates(),
-                 "rnea: qddot must have num_coordinates() entries");
+  detail::check_argument(chain, "rnea", "q", q);
+  detail::check_argument(chain, "rnea", "qdot", qdot);
+  detail::check_argument(chain, "rnea", "qddot", qddot);
   compute_kinematics(chain, data, q, qdot);
   detail::rnea_passes(chain, data, qdot, qddot, true, true, data.tau);
   return data.tau;

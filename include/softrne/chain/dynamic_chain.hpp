@@ -2,6 +2,7 @@
 /// \file
 /// \brief Chain whose segments are chosen at run time (e.g. read from a robot file).
 
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <variant>
@@ -53,16 +54,37 @@ class DynamicChain {
   const std::string& name(int i) const { return names_[static_cast<std::size_t>(i)]; }
   Data make_data() const { return Data(*this); }
 
+  /// \brief Throws std::invalid_argument naming the algorithm, the argument and both sizes
+  /// unless `size` == num_coordinates(). Always on, also in Release: a runtime chain is built
+  /// from a user's robot file, so its size is known only at run time (the compile-time
+  /// Chain<...> checks fixed-size arguments when it compiles).
+  void check_argument(const char* algorithm, const char* argument, Eigen::Index size) const {
+    if (size != nq_)
+      throw std::invalid_argument(std::string("softrne::") + algorithm + ": " + argument + " has " +
+                                  std::to_string(size) + " entries; the chain has " +
+                                  std::to_string(nq_) + " coordinates");
+  }
+  /// \brief Throws std::invalid_argument unless `data` was made by make_data() of a chain with
+  /// this one's segments. Always on, like check_argument().
+  void check_data(const Data& data) const {
+    if (data.kinematics.size() != segments_.size() || static_cast<int>(data.tau.size()) != nq_)
+      throw std::invalid_argument(
+          "softrne::DynamicChain: this Data was made for another chain (" +
+          std::to_string(data.kinematics.size()) + " segments, " + std::to_string(data.tau.size()) +
+          " coordinates; this chain has " + std::to_string(segments_.size()) + " and " +
+          std::to_string(nq_) + "; call make_data())");
+  }
+
   /// \brief Calls f(segment, kinematics, index, q_offset) base to tip.
   template <class F>
   void forward(Data& data, F&& f) const {
-    check(data);
+    check_data(data);
     for (int i = 0; i < num_segments(); ++i) visit(data, f, i);
   }
   /// \brief Calls f(segment, kinematics, index, q_offset) tip to base.
   template <class F>
   void backward(Data& data, F&& f) const {
-    check(data);
+    check_data(data);
     for (int i = num_segments() - 1; i >= 0; --i) visit(data, f, i);
   }
 
@@ -86,20 +108,14 @@ class DynamicChain {
           using Kin = typename std::decay_t<decltype(seg)>::Kinematics;
           // Same number of segments and coordinates but other types (a Data made for a
           // chain built in another order): a message here rather than bad_variant_access.
-          SOFTRNE_ASSERT(std::holds_alternative<Kin>(data.kinematics[k]),
-                         "DynamicChain: this Data was made for another chain (segment types "
-                         "differ; call make_data())");
+          if (!std::holds_alternative<Kin>(data.kinematics[k]))
+            throw std::invalid_argument(
+                "softrne::DynamicChain: this Data was made for another chain (segment " +
+                std::to_string(i) + " has another type; call make_data())");
           f(seg, std::get<Kin>(data.kinematics[k]), i, offsets_[k]);
         },
         segments_[k]);
   }
-  void check(const Data& data) const {
-    SOFTRNE_ASSERT(data.kinematics.size() == segments_.size() &&
-                       static_cast<int>(data.tau.size()) == nq_,
-                   "DynamicChain: this Data was made for another chain (call make_data())");
-    (void)data;
-  }
-
   std::vector<Segment> segments_;
   std::vector<std::string> names_;
   std::vector<int> offsets_;

@@ -11,6 +11,7 @@
 
 #include "softrne/chain/articulated_workspace.hpp"
 #include "softrne/chain/motion.hpp"
+#include "softrne/config.hpp"
 #include "softrne/segments/segment_concept.hpp"
 
 namespace softrne {
@@ -49,6 +50,16 @@ class Chain {
 
   int num_coordinates() const { return nq; }
   Data make_data() const { return Data(*this); }
+
+  /// \brief A fixed-size argument of another size does not compile (detail::check_argument);
+  /// a dynamic-size one (a VectorXd passed to a fixed chain) is checked in debug builds, as
+  /// Eigen checks sizes. The hot path of a controller pays nothing.
+  void check_argument(const char*, const char*, Eigen::Index size) const {
+    SOFTRNE_ASSERT(size == nq, "softrne::Chain: an argument's size is not the chain's nq");
+    (void)size;
+  }
+  /// \brief Nothing to check: the Data type belongs to this chain type alone.
+  void check_data(const Data&) const {}
 
   /// Offset of segment I's coordinates in q.
   template <std::size_t I>
