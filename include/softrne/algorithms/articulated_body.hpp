@@ -62,6 +62,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/algorithms/cholesky.hpp"
 #include "softrne/algorithms/kinematics.hpp"
 #include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/algorithms/own_inertia.hpp"
@@ -94,31 +95,11 @@ bool invert_spd_small(const MatD& D, MatDinv& Dinv) {
     Dinv(1, 0) = Dinv(0, 1);
     return true;
   } else {
-    using std::sqrt;
-    Eigen::Matrix<S, n, n> L = Eigen::Matrix<S, n, n>::Zero();
-    for (int j = 0; j < n; ++j) {
-      S d = D(j, j);
-      for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
-      if (!(d > S(0))) return false;
-      L(j, j) = sqrt(d);
-      for (int i = j + 1; i < n; ++i) {
-        S s = D(i, j);
-        for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
-        L(i, j) = s / L(j, j);
-      }
-    }
-    for (int c = 0; c < n; ++c) {  // column c of D^-1: L y = e_c, L^T x = y (no zero skipping)
-      Eigen::Matrix<S, n, 1> x;
-      for (int i = 0; i < n; ++i) {
-        S s = i == c ? S(1) : S(0);
-        for (int k = 0; k < i; ++k) s -= L(i, k) * x(k);
-        x(i) = s / L(i, i);
-      }
-      for (int i = n - 1; i >= 0; --i) {
-        S s = x(i);
-        for (int k = i + 1; k < n; ++k) s -= L(k, i) * x(k);
-        x(i) = s / L(i, i);
-      }
+    Eigen::Matrix<S, n, n> L = D;
+    if (!cholesky_factor_in_place(L)) return false;
+    for (int c = 0; c < n; ++c) {  // column c of D^-1 (no zero skipping: cholesky.hpp)
+      Eigen::Matrix<S, n, 1> x = Eigen::Matrix<S, n, 1>::Unit(c);
+      cholesky_solve_factored(L, x);
       for (int i = 0; i < n; ++i) Dinv(i, c) = x(i);
     }
     return true;
