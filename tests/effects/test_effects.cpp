@@ -1078,6 +1078,30 @@ TEST(MassScale, PerJointScalesTheJointAndItsLinksOnly) {
   EXPECT_EQ(shared.segment_mass_scale(), std::vector<double>(6, 1.3));
 }
 
+// RK4 on the effect states of `f` (from zero) with every coordinate driven by q = A sin(w t)
+// and zero pressures; after step i (of `steps`, of length dt) calls
+// visit(i, q, qdot, states) with q, qdot at the end of the step.
+template <class Visit>
+void drive_effect_states_by_a_sinusoid(ArmDynamics<double>& f, const ArmDescription& d, double A,
+                                       double w, double dt, int steps, Visit&& visit) {
+  const VectorXd p = VectorXd::Zero(d.num_inputs);
+  auto q_at = [&](double t) { return VectorXd(VectorXd::Constant(d.nq, A * std::sin(w * t))); };
+  auto qd_at = [&](double t) { return VectorXd(VectorXd::Constant(d.nq, A * w * std::cos(w * t))); };
+  auto xdot = [&](double t, const VectorXd& x) {
+    VectorXd r(x.size());
+    f.effect_state_derivative(x, q_at(t), qd_at(t), p, r);
+    return r;
+  };
+  VectorXd x = VectorXd::Zero(d.num_effect_states);
+  for (int i = 0; i < steps; ++i) {
+    const double t = i * dt;
+    const VectorXd k1 = xdot(t, x), k2 = xdot(t + dt / 2, x + dt / 2 * k1),
+                   k3 = xdot(t + dt / 2, x + dt / 2 * k2), k4 = xdot(t + dt, x + dt * k3);
+    x += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    visit(i, q_at(t + dt), qd_at(t + dt), x);
+  }
+}
+
 TEST(Hysteresis, ASlowSinusoidTracesALoopThatSaturatesAtFmax) {
   const double f_max = 0.4, sigma = 60.0, A = 0.3;
   const ArmDescription d = with_effect(effect("hysteresis", Scope::Shared, {f_max, sigma}));
@@ -1086,23 +1110,11 @@ TEST(Hysteresis, ASlowSinusoidTracesALoopThatSaturatesAtFmax) {
   // The Dahl state of coordinate 0 driven by q = A sin(w t) (the same on every coordinate),
   // by RK4 on the effect's own state derivative, over 2.25 periods.
   auto run = [&](double w, std::vector<double>& qs, std::vector<double>& Fs) {
-    VectorXd F = VectorXd::Zero(d.num_effect_states);
-    const double T = 2 * M_PI / w, dt = T / 20000;
-    auto Fdot = [&](double t, const VectorXd& x) {
-      const VectorXd q = VectorXd::Constant(d.nq, A * std::sin(w * t));
-      const VectorXd qd = VectorXd::Constant(d.nq, A * w * std::cos(w * t));
-      VectorXd r(x.size());
-      f.effect_state_derivative(x, q, qd, p, r);
-      return r;
-    };
-    for (int i = 0; i < 45000; ++i) {
-      const double t = i * dt;
-      const VectorXd k1 = Fdot(t, F), k2 = Fdot(t + dt / 2, F + dt / 2 * k1),
-                     k3 = Fdot(t + dt / 2, F + dt / 2 * k2), k4 = Fdot(t + dt, F + dt * k3);
-      F += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-      qs.push_back(A * std::sin(w * (t + dt)));
-      Fs.push_back(F(0));
-    }
+    drive_effect_states_by_a_sinusoid(f, d, A, w, 2 * M_PI / w / 20000, 45000,
+                                      [&](int, const VectorXd& q, const VectorXd&, const VectorXd& F) {
+                                        qs.push_back(q(0));
+                                        Fs.push_back(F(0));
+                                      });
   };
   std::vector<double> q_slow, F_slow, q_fast, F_fast;
   run(0.5, q_slow, F_slow);
@@ -1160,29 +1172,20 @@ TEST(Hysteresis, AtItsLargestStiffnessItIsCoulombFriction) {
   const ArmDescription dh = with_effect(effect("hysteresis", Scope::Shared, {f_max, sigma}));
   const ArmDescription dc = with_effect(effect("coulomb_friction", Scope::Shared, {f_max}));
   ArmDynamics<double> fh(dh), fc(dc);
-  const VectorXd p = VectorXd::Zero(dh.num_inputs), pe = p;
-  const double T = 2 * M_PI / w, dt = T / 200000;
-  VectorXd F = VectorXd::Zero(dh.num_effect_states);
-  auto Fdot = [&](double t, const VectorXd& x) {
-    const VectorXd q = VectorXd::Constant(dh.nq, A * std::sin(w * t));
-    const VectorXd qd = VectorXd::Constant(dh.nq, A * w * std::cos(w * t));
-    VectorXd r(x.size());
-    fh.effect_state_derivative(x, q, qd, p, r);
-    return r;
-  };
+  const VectorXd pe = VectorXd::Zero(dh.num_inputs);
   double worst = 0, near_reversal = 0;
-  for (int i = 0; i < 400000; ++i) {  // two periods, the second one checked
-    const double t = i * dt;
-    const VectorXd k1 = Fdot(t, F), k2 = Fdot(t + dt / 2, F + dt / 2 * k1),
-                   k3 = Fdot(t + dt / 2, F + dt / 2 * k2), k4 = Fdot(t + dt, F + dt * k3);
-    F += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-    if (i < 200000) continue;
-    const VectorXd q = VectorXd::Constant(dh.nq, A * std::sin(w * (t + dt)));
-    const VectorXd qd = VectorXd::Constant(dh.nq, A * w * std::cos(w * (t + dt)));
-    const double diff = (fh.joint_forces(q, qd, pe, F) - fc.joint_forces(q, qd, pe, VectorXd())).cwiseAbs().maxCoeff();
-    if (std::abs(qd(0)) > 5 * softrne::CoulombFriction::kSmoothingSpeed) worst = std::max(worst, diff);
-    else near_reversal = std::max(near_reversal, diff);
-  }
+  // Two periods, the second one checked.
+  drive_effect_states_by_a_sinusoid(
+      fh, dh, A, w, 2 * M_PI / w / 200000, 400000,
+      [&](int i, const VectorXd& q, const VectorXd& qd, const VectorXd& F) {
+        if (i < 200000) return;
+        const double diff =
+            (fh.joint_forces(q, qd, pe, F) - fc.joint_forces(q, qd, pe, VectorXd())).cwiseAbs().maxCoeff();
+        if (std::abs(qd(0)) > 5 * softrne::CoulombFriction::kSmoothingSpeed)
+          worst = std::max(worst, diff);
+        else
+          near_reversal = std::max(near_reversal, diff);
+      });
   EXPECT_LT(worst, 1e-3 * f_max);
   EXPECT_GT(near_reversal, 0.1 * f_max);  // the comparison did cross the reversals
 }
