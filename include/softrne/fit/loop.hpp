@@ -273,14 +273,10 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   log("baseline fit of stiffness and damping");
   out.baseline = fit_arm(declared, train, opt.fit);
   out.simulations += out.baseline.simulations;
-  auto test_stats = [&](const ArmDescription& d) {
-    ErrorStats s;
-    if (!test) return s;
-    const auto sim = simulate_dataset(d, *test, sim_opt);
-    if (sim.ok()) s = error_stats(sim.angles, test->angles, d.coordinate_names);
-    return s;
-  };
-  out.baseline_test = test_stats(out.baseline.fitted);
+  if (test) {
+    const sim::ArmSimulation s = simulate_dataset(out.baseline.fitted, *test, sim_opt);
+    if (s.ok()) out.baseline_test = error_stats(s.angles, test->angles, out.baseline.fitted.coordinate_names);
+  }
 
   // Fold base models, each fitted from the declared model on its own training blocks.
   std::vector<detail::Fold> folds = detail::make_folds(N, opt.cv_blocks);
@@ -559,25 +555,22 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
 
   out.final_fit = current_fit;
   out.final_train = current_fit.stats;
-  out.final_test = test_stats(current);
-  auto residual = [&](const ArmDescription& d, const io::Dataset& data) {
-    const Eigen::MatrixXd y = detail::simulated_angles(d, data, sim_opt);
-    return y.size() ? Eigen::MatrixXd(data.angles - y) : Eigen::MatrixXd();
-  };
-  // The fits' own simulations through every training sample (fit_arm keeps them).
-  out.baseline_residual = out.baseline.angles.size() ? Eigen::MatrixXd(train.angles - out.baseline.angles)
-                                                     : residual(out.baseline.fitted, train);
-  out.final_residual = current_fit.angles.size() ? Eigen::MatrixXd(train.angles - current_fit.angles)
-                                                 : residual(current, train);
+  // The training residuals come from the fits' own simulations (fit_arm keeps them; empty if
+  // that simulation failed); the final model is simulated once on the test data, for its
+  // statistics and its residual analysis.
+  if (out.baseline.angles.size()) out.baseline_residual = train.angles - out.baseline.angles;
+  if (current_fit.angles.size()) out.final_residual = train.angles - current_fit.angles;
+  const sim::ArmSimulation final_test_sim =
+      test ? simulate_dataset(current, *test, sim_opt) : sim::ArmSimulation();
+  if (test && final_test_sim.ok())
+    out.final_test = error_stats(final_test_sim.angles, test->angles, current.coordinate_names);
   if (out.final_residual.size())
     out.unexplained_train = analyse_residual(current, train.t, train.angles, train.angles - out.final_residual,
                                              train.pressures, out.noise_sigma, opt.unexplained_ratio);
-  if (test && test->has_angles) {
-    const Eigen::MatrixXd rt = residual(current, *test);
-    if (rt.size())
-      out.unexplained_test = analyse_residual(current, test->t, test->angles, test->angles - rt, test->pressures,
-                                              out.noise_sigma, opt.unexplained_ratio);
-  }
+  if (test && test->has_angles && final_test_sim.ok() && final_test_sim.angles.rows() == test->t.size() &&
+      final_test_sim.angles.allFinite())
+    out.unexplained_test = analyse_residual(current, test->t, test->angles, final_test_sim.angles, test->pressures,
+                                            out.noise_sigma, opt.unexplained_ratio);
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
