@@ -34,6 +34,29 @@ TEST(ArmFit, RecoversStiffnessAndDampingFromNoisyData) {
               r.stats.total.mean);
 }
 
+// simulate_dataset integrates no looser than the model's effects need (effect_max_atol):
+// with a Coulomb friction, a caller's atol 1e-3 gives exactly the run at Coulomb's 1e-6.
+TEST(ArmFit, SimulationsOfAModelWithCoulombFrictionUseItsTolerance) {
+  ArmDescription arm = build_arm(softrne_test::two_joint_spec());
+  const io::Dataset data = softrne_test::synthetic_dataset(arm, 2.0, 2.0, 5);
+  sim::ArmSimulationOptions loose;
+  loose.cvode.atol = 1e-3;
+  sim::ArmSimulationOptions tight = loose;
+  tight.cvode.atol = CoulombFriction::max_atol;
+  const Eigen::VectorXd q0 = data.angles.row(0).transpose();
+  auto direct = [&](const ArmDescription& d, const sim::ArmSimulationOptions& o) {
+    return sim::simulate_arm(d, data.t, data.pressures, q0, o).angles;
+  };
+  // Without the effect the caller's tolerance holds (and differs from the tight run).
+  EXPECT_EQ(fit::simulate_dataset(arm, data, loose).angles, direct(arm, loose));
+  EXPECT_NE(direct(arm, loose), direct(arm, tight));
+  AnyEffect e = make_effect_at_neutral("coulomb_friction", arm, Scope::Shared);
+  effect_base(e).params.setConstant(0.05);
+  add_effect(arm, e);
+  EXPECT_EQ(fit::simulate_dataset(arm, data, loose).angles, direct(arm, tight));
+  EXPECT_EQ(effect_max_atol(AnyEffect(Hysteresis{})), std::numeric_limits<double>::infinity());
+}
+
 TEST(ArmFit, BadDataIsRefusedWithAClearMessage) {
   const ArmDescription arm = build_arm(softrne_test::two_joint_spec());
   io::Dataset d = softrne_test::synthetic_dataset(arm, 1.0, 0.5, 3);

@@ -5,6 +5,8 @@
 /// the robot-file reader, so none of them lists effect-specific numbers.
 
 #include <algorithm>
+#include <limits>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -56,11 +58,46 @@ inline std::string effect_reduces_to(const AnyEffect& e) {
       e);
 }
 
+namespace detail {
+template <class E, class = void>
+struct HasMaxAtol : std::false_type {};
+template <class E>
+struct HasMaxAtol<E, std::void_t<decltype(E::max_atol)>> : std::true_type {};
+}  // namespace detail
+
+/// \brief The loosest integrator atol at which the effect's force is resolved (its header's
+/// `max_atol`: a sharp feature such as smoothed Coulomb friction), or +infinity if it sets
+/// none. fit::simulate_dataset integrates no looser than its model's effects require.
+inline double effect_max_atol(const AnyEffect& e) {
+  return std::visit(
+      [](const auto& x) -> double {
+        using E = std::decay_t<decltype(x)>;
+        if constexpr (detail::HasMaxAtol<E>::value) return E::max_atol;
+        else return std::numeric_limits<double>::infinity();
+      },
+      e);
+}
+
 /// \brief Number of parameter kinds per unit (2 for viscoelastic: k and tau).
 inline int effect_num_kinds(const AnyEffect& e) {
   return std::visit(
       [](const auto& x) { return static_cast<int>(std::decay_t<decltype(x)>::param_info.size()); },
       e);
+}
+
+/// \brief The parameters of `simpler`, the effect `rich` reduces to (effect_reduces_to) on the
+/// same scope and joints, taken from `rich`'s: per unit, `rich`'s first kinds (the layout is
+/// `params(unit * num_kinds + kind)`, effect_base.hpp).
+inline Eigen::VectorXd effect_reduced_params(const AnyEffect& rich, const AnyEffect& simpler) {
+  if (effect_reduces_to(rich) != effect_name(simpler))
+    throw std::invalid_argument("effect_reduced_params: '" + effect_name(rich) + "' does not reduce to '" +
+                                effect_name(simpler) + "'");
+  const int kr = effect_num_kinds(rich), ks = effect_num_kinds(simpler);
+  const Eigen::VectorXd& p = effect_base(rich).params;
+  const Eigen::Index units = p.size() / kr;
+  Eigen::VectorXd out(units * ks);
+  for (Eigen::Index u = 0; u < units; ++u) out.segment(u * ks, ks) = p.segment(u * kr, ks);
+  return out;
 }
 
 /// \brief Description of parameter kind `kind`.

@@ -3,6 +3,7 @@
 /// \brief System identification of an arm: stiffness, damping (and optionally pressure gains
 /// and effect parameters) fitted to measured angles by simulation error (paper section IV-B).
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -42,7 +43,8 @@ struct ArmFitOptions {
   /// simulated angles, so neither the objective nor its Jacobian sees the integrator. 1e-6
   /// made every simulation 1.6 to 1.9 times as long (3-joint arm, distributed inertia: 12.0k
   /// instead of 7.4k steps) for no change: the closed loop on random arm 1001 took 85.6 s
-  /// instead of 53.9 s with the same decisions and held-out gains to 0.1 %.
+  /// instead of 53.9 s with the same decisions and held-out gains to 0.1 %. Effects with a
+  /// sharp feature tighten it for the models that hold them (simulate_dataset).
   static sim::ArmSimulationOptions default_simulation() {
     sim::ArmSimulationOptions s;
     s.cvode.rtol = 1e-6;
@@ -160,14 +162,19 @@ SOFTRNE_FIT_INLINE void apply(const std::vector<ParamSlot>& slots, const Eigen::
 
 }  // namespace detail
 
-/// \brief Simulates the arm on a data set (from rest at the first measured row).
+/// \brief Simulates the arm on a data set (from rest at the first measured row), at
+/// `opt`'s tolerances or tighter where the model's effects need it (effect_max_atol: a
+/// smoothed Coulomb friction needs atol 1e-6), so that every fit, screen and held-out error
+/// sees such an effect resolved whatever the caller's default.
 SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d, const io::Dataset& data,
                                                        const sim::ArmSimulationOptions& opt)
 #if SOFTRNE_FIT_BODIES
 {
   const Eigen::VectorXd q0 =
       data.has_angles ? Eigen::VectorXd(data.angles.row(0).transpose()) : Eigen::VectorXd::Zero(d.nq);
-  return sim::simulate_arm(d, data.t, data.pressures, q0, opt);
+  sim::ArmSimulationOptions o = opt;
+  for (const AnyEffect& e : d.effects) o.cvode.atol = std::min(o.cvode.atol, effect_max_atol(e));
+  return sim::simulate_arm(d, data.t, data.pressures, q0, o);
 }
 #else
 ;
