@@ -575,6 +575,20 @@ TYPED_TEST(EveryEffect, ItsSimplerLimitIsAnEffectWithItsFirstKinds) {
   for (int k = 0; k < softrne::effect_num_kinds(s); ++k)
     EXPECT_EQ(std::string(softrne::effect_param_info(s, k).unit), softrne::effect_param_info(e, k).unit);
   for (Scope sc : E::scopes) EXPECT_TRUE(softrne::effect_scope_allowed(s, sc)) << softrne::scope_name(sc);
+  // The loop starts the simpler limit where the richer fit ended: per unit, the first kinds.
+  for (const AnyEffect& rich_neutral : this->neutral_in_every_scope()) {
+    AnyEffect rich = rich_neutral;
+    const EffectBase& b = softrne::effect_base(rich);
+    Eigen::VectorXd& p = softrne::effect_base(rich).params;
+    for (Eigen::Index i = 0; i < p.size(); ++i) p(i) = 10.0 * static_cast<double>(i) + 1.0;
+    const AnyEffect simple_neutral = softrne::make_effect_at_neutral(simpler, declared(), b.scope, b.joints);
+    const Eigen::VectorXd r = softrne::effect_reduced_params(rich, simple_neutral);
+    const int kr = softrne::effect_num_kinds(rich), ks = softrne::effect_num_kinds(simple_neutral);
+    ASSERT_EQ(r.size(), softrne::effect_num_params(simple_neutral, declared().joints)) << softrne::scope_name(b.scope);
+    for (Eigen::Index u = 0; u < r.size() / ks; ++u)
+      for (int k = 0; k < ks; ++k) EXPECT_EQ(r(u * ks + k), p(u * kr + k)) << softrne::scope_name(b.scope);
+  }
+  EXPECT_THROW(softrne::effect_reduced_params(s, e), std::invalid_argument);
 }
 
 TYPED_TEST(EveryEffect, ParameterNamesFollowTheRobotFileRules) {
