@@ -443,9 +443,11 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     // in the same scope, refitted too, wherever the screen ranked it: the screen cannot tell
     // the two apart, the held-out error and parsimony below can. It starts in each fold where
     // the richer effect's refit ended (its first kinds are the simpler one's: Dahl's fitted
-    // Fmax is Coulomb's Fc), also when the screen's start was refitted already: from there
-    // the local refit of a Coulomb friction stalled at half the gain of the Dahl element
-    // (random arm 1007: -35 % / -43 % against -65 % / -72 %).
+    // Fmax is Coulomb's Fc), also when the screen's start was refitted already, and keeps the
+    // better of the two refits: the richer fit is the better-informed start for a local
+    // refit. (Random arm 1007's Coulomb refit, once stalled at half the Dahl element's gain,
+    // was held back by the integrator's tolerance, not by its start: CoulombFriction's
+    // max_atol.)
     const std::vector<int> passed_screen_starts = passing;
     for (int rich_index : passed_screen_starts) {
       const std::size_t rich = static_cast<std::size_t>(rich_index);
