@@ -57,17 +57,19 @@ Eigen::MatrixXd chunked_gradients(const VectorXd& x, int m, F&& f) {
   return g;
 }
 
-/// dT/dq, dT/dqd, dV/dq at (q, qd) of the energies that energies(q, qd, T, V) computes with
-/// AutoDiff scalars ADT.
-template <class ADT, class Energies>
-void lagrangian_gradients(Energies&& energies, const VectorXd& q, const VectorXd& qd, VectorXd& dT_dq,
-                          VectorXd& dT_dqd, VectorXd& dV_dq) {
+/// dT/dq, dT/dqd, dV/dq at (q, qd) of the energies T and V that
+/// energies(chain_ad, q, qd, T, V) computes on `chain_ad`, a chain cast to an AutoDiff scalar
+/// with fixed-size derivatives (ADL).
+template <class Energies, class ChainAD>
+void lagrangian_gradients(const Energies& energies, const ChainAD& chain_ad, const VectorXd& q, const VectorXd& qd,
+                          VectorXd& dT_dq, VectorXd& dT_dqd, VectorXd& dV_dq) {
+  using ADT = typename ChainAD::Scalar;
   using QV = Eigen::Matrix<ADT, Eigen::Dynamic, 1>;
   const int n = static_cast<int>(q.size());
   VectorXd x(2 * n);
   x << q, qd;
   const Eigen::MatrixXd g = chunked_gradients<ADT>(x, 2, [&](const QV& xa, ADT* TV) {
-    energies(QV(xa.head(n)), QV(xa.tail(n)), TV[0], TV[1]);
+    energies(chain_ad, QV(xa.head(n)), QV(xa.tail(n)), TV[0], TV[1]);
   });
   dT_dq = g.row(0).head(n).transpose();
   dT_dqd = g.row(0).tail(n).transpose();
@@ -77,10 +79,11 @@ void lagrangian_gradients(Energies&& energies, const VectorXd& q, const VectorXd
 /// The Euler-Lagrange generalised forces tau = d/dt(dT/dqd) - dT/dq + dV/dq of those energies;
 /// AutoDiff gives the partials exactly, d/dt is an 8th-order central difference along
 /// q(t) = q + t qd + t^2/2 qdd.
-template <class ADT, class Energies>
-VectorXd euler_lagrange(Energies&& energies, const VectorXd& q, const VectorXd& qd, const VectorXd& qdd) {
+template <class Energies, class ChainAD>
+VectorXd euler_lagrange(const Energies& energies, const ChainAD& chain_ad, const VectorXd& q, const VectorXd& qd,
+                        const VectorXd& qdd) {
   VectorXd dTq, dTqd, dVq;
-  lagrangian_gradients<ADT>(energies, q, qd, dTq, dTqd, dVq);
+  lagrangian_gradients(energies, chain_ad, q, qd, dTq, dTqd, dVq);
   const double c[4] = {4.0 / 5, -1.0 / 5, 4.0 / 105, -1.0 / 280};
   const double h = 2e-3;
   VectorXd ddt = VectorXd::Zero(q.size());
@@ -88,8 +91,8 @@ VectorXd euler_lagrange(Energies&& energies, const VectorXd& q, const VectorXd& 
     for (int sgn : {1, -1}) {
       const double t = sgn * k * h;
       VectorXd a, b, e;
-      lagrangian_gradients<ADT>(energies, VectorXd(q + t * qd + 0.5 * t * t * qdd), VectorXd(qd + t * qdd), a, b,
-                                e);
+      lagrangian_gradients(energies, chain_ad, VectorXd(q + t * qd + 0.5 * t * t * qdd), VectorXd(qd + t * qdd), a,
+                           b, e);
       ddt += sgn * c[k - 1] * b / h;
     }
   }

@@ -340,24 +340,10 @@ void energies(const ChainT& chain, const QV& q, const QV& qd, typename ChainT::S
 }
 
 #if SOFTRNE_TEST_AUTODIFF_REFERENCES
-// The reference's entry points on a chain cast to softrne_test::ADL (support.hpp).
-template <class ChainAD>
-auto chain_energies(const ChainAD& chain_ad) {
-  using QV = Eigen::Matrix<typename ChainAD::Scalar, Eigen::Dynamic, 1>;
-  return [&chain_ad](const QV& q, const QV& qd, typename ChainAD::Scalar& T, typename ChainAD::Scalar& V) {
-    energies(chain_ad, q, qd, T, V);
-  };
-}
-template <class ChainAD>
-void lagrangian_gradients(const ChainAD& chain_ad, const VectorXd& q, const VectorXd& qd, VectorXd& dT_dq,
-                          VectorXd& dT_dqd, VectorXd& dV_dq) {
-  softrne_test::lagrangian_gradients<typename ChainAD::Scalar>(chain_energies(chain_ad), q, qd, dT_dq, dT_dqd,
-                                                               dV_dq);
-}
-template <class ChainAD>
-VectorXd euler_lagrange(const ChainAD& chain_ad, const VectorXd& q, const VectorXd& qd, const VectorXd& qdd) {
-  return softrne_test::euler_lagrange<typename ChainAD::Scalar>(chain_energies(chain_ad), q, qd, qdd);
-}
+// The energies above as one object, for the references of support.hpp.
+constexpr auto kEnergies = [](const auto& chain, const auto& q, const auto& qd, auto& T, auto& V) {
+  energies(chain, q, qd, T, V);
+};
 #endif
 
 // Distributed CC joints mixed with links, a revolute joint and a lumped CC joint.
@@ -397,7 +383,7 @@ void check_against_lagrangian(const DynamicChain<double>& chain, int states, dou
     const VectorXd qd = softrne_test::random_vector(rng, n, 2.0);
     const VectorXd qdd = softrne_test::random_vector(rng, n, 5.0);
     const VectorXd tau = rnea(chain, data, q, qd, qdd);
-    const VectorXd ref = euler_lagrange(chain_ad, q, qd, qdd);
+    const VectorXd ref = softrne_test::euler_lagrange(kEnergies, chain_ad, q, qd, qdd);
     const double e = (tau - ref).norm() / std::max(1e-3, ref.norm());
     worst = std::max(worst, e);
     ASSERT_LT(e, 1e-9) << "state " << s << "\nrnea " << tau.transpose() << "\nEL   " << ref.transpose();

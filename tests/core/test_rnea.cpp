@@ -62,24 +62,10 @@ void energies(const ChainT& chain, const QV& q, const QV& qd, typename ChainT::S
   });
 }
 
-// The reference's entry points on a chain cast to softrne_test::ADL (support.hpp).
-template <class ChainAD>
-auto chain_energies(const ChainAD& chain_ad) {
-  using QV = Eigen::Matrix<typename ChainAD::Scalar, Eigen::Dynamic, 1>;
-  return [&chain_ad](const QV& q, const QV& qd, typename ChainAD::Scalar& T, typename ChainAD::Scalar& V) {
-    energies(chain_ad, q, qd, T, V);
-  };
-}
-template <class ChainAD>
-void lagrangian_gradients(const ChainAD& chain_ad, const VectorXd& q, const VectorXd& qd, VectorXd& dT_dq,
-                          VectorXd& dT_dqd, VectorXd& dV_dq) {
-  softrne_test::lagrangian_gradients<typename ChainAD::Scalar>(chain_energies(chain_ad), q, qd, dT_dq, dT_dqd,
-                                                               dV_dq);
-}
-template <class ChainAD>
-VectorXd euler_lagrange(const ChainAD& chain_ad, const VectorXd& q, const VectorXd& qd, const VectorXd& qdd) {
-  return softrne_test::euler_lagrange<typename ChainAD::Scalar>(chain_energies(chain_ad), q, qd, qdd);
-}
+// The energies above as one object, for the references of support.hpp.
+constexpr auto kEnergies = [](const auto& chain, const auto& q, const auto& qd, auto& T, auto& V) {
+  energies(chain, q, qd, T, V);
+};
 #endif
 
 DynamicChain<double> cc_only() {
@@ -128,7 +114,7 @@ void check_against_lagrangian(const DynamicChain<double>& chain, int states, dou
     const VectorXd qd = softrne_test::random_vector(rng, n, 2.0);
     const VectorXd qdd = softrne_test::random_vector(rng, n, 5.0);
     const VectorXd tau = rnea(chain, data, q, qd, qdd);
-    const VectorXd ref = euler_lagrange(chain_ad, q, qd, qdd);
+    const VectorXd ref = softrne_test::euler_lagrange(kEnergies, chain_ad, q, qd, qdd);
     const double e = (tau - ref).norm() / std::max(1e-3, ref.norm());
     worst = std::max(worst, e);
     ASSERT_LT(e, 1e-9) << "state " << s << "\nrnea " << tau.transpose() << "\nEL   " << ref.transpose();
@@ -152,10 +138,11 @@ TEST(RneaLagrangian, PaperFrozenInertiaIsNotLagrangian) {
   const VectorXd q = softrne_test::random_vector(rng, 6, 1.0);
   const VectorXd qd = softrne_test::random_vector(rng, 6, 2.0);
   const VectorXd qdd = softrne_test::random_vector(rng, 6, 5.0);
-  const VectorXd ref = euler_lagrange(chain_ad, q, qd, qdd);
+  const VectorXd ref = softrne_test::euler_lagrange(kEnergies, chain_ad, q, qd, qdd);
   EXPECT_GT((rnea(chain, data, q, qd, qdd) - ref).norm() / ref.norm(), 1e-6);
   const VectorXd z = VectorXd::Zero(6);
-  EXPECT_LT((rnea(chain, data, q, z, qdd) - euler_lagrange(chain_ad, q, z, qdd)).norm(), 1e-9);
+  const VectorXd ref_at_rest = softrne_test::euler_lagrange(kEnergies, chain_ad, q, z, qdd);
+  EXPECT_LT((rnea(chain, data, q, z, qdd) - ref_at_rest).norm(), 1e-9);
 }
 #else
 TEST(RneaLagrangian, InTheReleaseTestsOnly) {
@@ -191,7 +178,7 @@ TEST(RneaIdentities, GravityBiasMassMatrix) {
 #if SOFTRNE_TEST_AUTODIFF_REFERENCES
       // G = dV/dq.
       VectorXd a, b, dV;
-      lagrangian_gradients(chain_ad, q, qd, a, b, dV);
+      softrne_test::lagrangian_gradients(kEnergies, chain_ad, q, qd, a, b, dV);
       EXPECT_LT(softrne_test::rel_err(G, dV), 1e-12);
 #endif
       // qd^T (dM/dt - 2C) qd = 0 with dM/dt by a central difference along qd.
