@@ -25,6 +25,17 @@ void check_argument(const ChainT& chain, const char* algorithm, const char* argu
     chain.check_argument(algorithm, argument, v.size());
 }
 
+/// \brief One segment's entries of a chain-sized vector, as a fixed-size vector of its own.
+/// The per-segment functions (`calc`, the RNE steps) then see one argument type per segment
+/// type instead of a Block of each chain's vector type and of each caller's expression: they
+/// are instantiated once per segment type, not once per (segment type, chain, argument type).
+/// It copies nq <= 2 scalars, which the optimiser removes where the step is inlined.
+template <int n, class V>
+Eigen::Matrix<typename V::Scalar, n, 1> segment_entries(const Eigen::MatrixBase<V>& v,
+                                                        int offset) {
+  return v.template segment<n>(offset);
+}
+
 }  // namespace detail
 
 /// \brief Calls every segment's `calc(q, qdot)`: rotations, positions, Jacobians, their rates
@@ -39,7 +50,7 @@ void compute_kinematics(const ChainT& chain, typename ChainT::Data& data,
   detail::check_argument(chain, "compute_kinematics", "qdot", qdot);
   chain.forward(data, [&](const auto& seg, auto& kin, int, int offset) {
     constexpr int n = std::decay_t<decltype(seg)>::nq;
-    seg.calc(q.template segment<n>(offset), qdot.template segment<n>(offset), kin);
+    seg.calc(detail::segment_entries<n>(q, offset), detail::segment_entries<n>(qdot, offset), kin);
   });
 }
 

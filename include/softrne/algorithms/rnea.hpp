@@ -30,16 +30,18 @@ void rnea_passes(const ChainT& chain, typename ChainT::Data& data,
   chain.forward(data, [&](const auto& seg, const auto& kin, int i, int offset) {
     constexpr int n = std::decay_t<decltype(seg)>::nq;
     const auto k = static_cast<std::size_t>(i);
-    forward_step(seg, kin, data.motion[k], qdot.template segment<n>(offset),
-                 qddot.template segment<n>(offset), velocity_terms, chain.inertia_rate,
+    forward_step(seg, kin, data.motion[k], segment_entries<n>(qdot, offset),
+                 segment_entries<n>(qddot, offset), velocity_terms, chain.inertia_rate,
                  data.motion[k + 1], data.loads[k]);
   });
   data.wrench[static_cast<std::size_t>(data.num_segments())] = Wrench<Scalar>{};
   chain.backward(data, [&](const auto& seg, const auto& kin, int i, int offset) {
     constexpr int n = std::decay_t<decltype(seg)>::nq;
     const auto k = static_cast<std::size_t>(i);
-    backward_step(seg, kin, data.loads[k], data.wrench[k + 1], chain.inertia_rate,
-                  out.template segment<n>(offset), data.wrench[k]);
+    Eigen::Matrix<Scalar, n, 1> tau;  // fixed-size, as the step's inputs (segment_entries)
+    backward_step(seg, kin, data.loads[k], data.wrench[k + 1], chain.inertia_rate, tau,
+                  data.wrench[k]);
+    if constexpr (n > 0) out.template segment<n>(offset) = tau;
   });
 }
 

@@ -160,11 +160,12 @@ void forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
 /// through its centre-of-mass and angular Jacobians. (Taking the x/y torque components at a
 /// frame is not the same: the tip of a CC joint moves about half as far as a rigid rotation
 /// about its base would move it.)
-template <class Segment, class Tau>
+template <class Segment>
 void backward_step(const Segment&, const typename Segment::Kinematics& kin,
                    const BodyLoad<typename Segment::Scalar>& load,
                    const Wrench<typename Segment::Scalar>& distal, InertiaRate inertia_rate,
-                   const Eigen::MatrixBase<Tau>& tau_out, Wrench<typename Segment::Scalar>& base) {
+                   Eigen::Matrix<typename Segment::Scalar, Segment::nq, 1>& tau,
+                   Wrench<typename Segment::Scalar>& base) {
   using Scalar = typename Segment::Scalar;
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   constexpr int nq = Segment::nq;
@@ -173,7 +174,6 @@ void backward_step(const Segment&, const typename Segment::Kinematics& kin,
   const Vector3 F = turns ? Vector3(R * distal.force) : distal.force;
   const Vector3 N = turns ? Vector3(R * distal.torque) : distal.torque;
   if constexpr (nq > 0) {
-    auto& tau = const_cast<Eigen::MatrixBase<Tau>&>(tau_out);
     if constexpr (has_zero_translation<Segment>::value) {  // J_v = 0
       tau.noalias() = kin.J_distal.template bottomRows<3>().transpose() * N;
     } else {
