@@ -401,6 +401,9 @@ def main():
                     help="score cases whose report is already in WORK from it and run only the others "
                          "(delete a case folder to run it again)")
     ap.add_argument("--loop-arg", action="append", default=[], help="extra argument for softrne-loop (repeatable)")
+    ap.add_argument("--pick", action="append", default=[],
+                    help="run and score only the planned cases with these seeds (repeat or comma separate); "
+                         "the plan is still that of --cases and --seed, so a case is the same as in the full run")
     args = ap.parse_args()
     if args.cases < 1:
         die("--cases must be >= 1")
@@ -429,6 +432,15 @@ def main():
     args.work = os.path.abspath(args.work)
     os.makedirs(args.work, exist_ok=True)
     plan = plan_cases(args.cases, args.seed, pool, args.controls_only)
+    if args.pick:
+        try:
+            picked = {int(x) for p in args.pick for x in p.split(",") if x}
+        except ValueError:
+            die("--pick: seeds are integers")
+        missing = sorted(picked - {s for s, _ in plan})
+        if missing:
+            die(f"--pick: seed {missing[0]} is not in the plan (seeds {args.seed}..{args.seed + args.cases - 1})")
+        plan = [(s, e) for s, e in plan if s in picked]
     results = [None] * len(plan)
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as ex:
         futs = {ex.submit(run_case, args, s, e, tools): i for i, (s, e) in enumerate(plan)}
