@@ -470,6 +470,36 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
         break;
       }
     }
+    // A passing effect in a narrower scope (per joint, coordinate or chamber) has its shared
+    // scope refitted too, wherever the screen ranked it: the joint that carries most of a
+    // shared effect's signal dominates the screen's linearised gains, so two narrower scopes
+    // on that joint could take the effect's two refits (random arms 1029 and 1034: actuator
+    // lag and pressure stiffening on both joints, reported on one). It starts in each fold
+    // where the narrower refit ended when that holds one value per kind (one joint), else at
+    // the screen's start. The held-out gain below then chooses: on a truly per-joint effect
+    // the shared scope puts the effect where it is not and loses.
+    const std::vector<int> passed_before_shared = passing;
+    for (int narrow_index : passed_before_shared) {
+      const std::size_t narrow = static_cast<std::size_t>(narrow_index);
+      const AnyEffect& e = cands[score_cand[narrow]].effect;
+      if (effect_base(e).scope == Scope::Shared) continue;
+      for (std::size_t r = 0; r < scores.size(); ++r) {
+        const AnyEffect& o = cands[score_cand[r]].effect;
+        if (scores[r].name != scores[narrow].name || effect_base(o).scope != Scope::Shared) continue;
+        if (scores[r].confirmed) break;  // refitted already (this round)
+        log("  refitting " + scores[r].label + ", the shared scope of " + scores[narrow].label);
+        std::vector<Eigen::VectorXd> starts;
+        for (std::size_t f = 0; f < folds.size(); ++f) {
+          const detail::FoldTrial& t = fold_trials[narrow][f];
+          const Eigen::VectorXd& screen_start = screens[f][score_cand[r]].start;
+          const bool same_size =
+              t.ok() && effect_base(t.fit.fitted.effects.back()).params.size() == screen_start.size();
+          starts.push_back(same_size ? effect_base(t.fit.fitted.effects.back()).params : screen_start);
+        }
+        confirm(r, starts);
+        break;
+      }
+    }
     // The best passing candidate; a simpler one (fewer parameters) wins if its remaining
     // held-out error is within min_gain of the best's, the same margin every effect must earn.
     int best = -1;
