@@ -438,6 +438,20 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       ++refitted;
       confirm(r, {});
     }
+    // Refits candidate r beside passing candidate `from`: in each fold it starts from
+    // start_from(the effect from's refit ended with, r's screen start), or at r's screen start
+    // where that refit failed.
+    auto confirm_beside = [&](std::size_t from, std::size_t r, const std::string& relation,
+                              const auto& start_from) {
+      log("  refitting " + scores[r].label + ", " + relation + " " + scores[from].label);
+      std::vector<Eigen::VectorXd> starts;
+      for (std::size_t f = 0; f < folds.size(); ++f) {
+        const detail::FoldTrial& t = fold_trials[from][f];
+        const Eigen::VectorXd& screen_start = screens[f][score_cand[r]].start;
+        starts.push_back(t.ok() ? start_from(t.fit.fitted.effects.back(), screen_start) : screen_start);
+      }
+      confirm(r, starts);
+    };
     // A passing effect that contains a simpler one as a limit (a Dahl element with a large
     // stiffness is Coulomb friction: the effect header's `reduces_to`) has the simpler one,
     // in the same scope, refitted too, wherever the screen ranked it: the screen cannot tell
@@ -459,14 +473,10 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
         if (scores[r].name != simpler || effect_base(o).scope != effect_base(e).scope ||
             effect_base(o).joints != effect_base(e).joints)
           continue;
-        log("  refitting " + scores[r].label + ", the simpler limit of " + scores[rich].label);
-        std::vector<Eigen::VectorXd> starts;
-        for (std::size_t f = 0; f < folds.size(); ++f) {
-          const detail::FoldTrial& t = fold_trials[rich][f];
-          starts.push_back(t.ok() ? effect_reduced_params(t.fit.fitted.effects.back(), o)
-                                  : screens[f][score_cand[r]].start);
-        }
-        confirm(r, starts);
+        confirm_beside(rich, r, "the simpler limit of",
+                       [&](const AnyEffect& fitted, const Eigen::VectorXd&) {
+                         return effect_reduced_params(fitted, o);
+                       });
         break;
       }
     }
@@ -487,16 +497,11 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
         const AnyEffect& o = cands[score_cand[r]].effect;
         if (scores[r].name != scores[narrow].name || effect_base(o).scope != Scope::Shared) continue;
         if (scores[r].confirmed) break;  // refitted already (this round)
-        log("  refitting " + scores[r].label + ", the shared scope of " + scores[narrow].label);
-        std::vector<Eigen::VectorXd> starts;
-        for (std::size_t f = 0; f < folds.size(); ++f) {
-          const detail::FoldTrial& t = fold_trials[narrow][f];
-          const Eigen::VectorXd& screen_start = screens[f][score_cand[r]].start;
-          const bool same_size =
-              t.ok() && effect_base(t.fit.fitted.effects.back()).params.size() == screen_start.size();
-          starts.push_back(same_size ? effect_base(t.fit.fitted.effects.back()).params : screen_start);
-        }
-        confirm(r, starts);
+        confirm_beside(narrow, r, "the shared scope of",
+                       [](const AnyEffect& fitted, const Eigen::VectorXd& screen_start) {
+                         const Eigen::VectorXd& p = effect_base(fitted).params;
+                         return p.size() == screen_start.size() ? p : screen_start;
+                       });
         break;
       }
     }
