@@ -281,7 +281,19 @@ bool articulated_passes(const ChainT& chain, typename ChainT::Data& data) {
 /// articulated joint inertia D is not positive definite (never, for positive masses), qddot
 /// is set to NaN. Allocates nothing (for a built-in scalar type). Unlike forward_dynamics()
 /// it leaves no mass matrix or Cholesky factor in data.
-/// \return data.qddot
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model.
+/// \param[in,out] data Its workspace, made by chain.make_data() (data.articulated holds the
+///   per-segment articulated inertias).
+/// \param[in] q The coordinates (dim chain.num_coordinates()).
+/// \param[in] qdot Their rates (dim chain.num_coordinates()).
+/// \param[in] tau Every generalised force other than inertia and gravity (dim
+///   chain.num_coordinates()), as for forward_dynamics().
+/// \return The accelerations, stored in data.qddot (NaN if an articulated inertia is not
+///   positive definite).
+/// \throws std::invalid_argument (DynamicChain only) if q, qdot or tau has another size than
+///   the chain or data was made for another chain.
 template <class ChainT, class Q, class Qd, class Tau>
 const typename ChainT::VectorQ& aba(const ChainT& chain, typename ChainT::Data& data,
                                     const Eigen::MatrixBase<Q>& q,

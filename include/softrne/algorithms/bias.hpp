@@ -9,7 +9,16 @@
 
 namespace softrne {
 
-/// \brief G(q): the RNE with qdot = qddot = 0 (section III-D). \return data.gravity_forces
+/// \brief The gravity forces G(q) of eq. 23: the RNE with qdot = qddot = 0 (paper section
+/// III-D).
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model: its segments and gravity (base frame).
+/// \param[in,out] data Its workspace, made by chain.make_data().
+/// \param[in] q The coordinates (dim chain.num_coordinates()).
+/// \return G(q), stored in data.gravity_forces.
+/// \throws std::invalid_argument (DynamicChain only) if q has another size than the chain or
+///   data was made for another chain.
 template <class ChainT, class Q>
 const typename ChainT::VectorQ& gravity(const ChainT& chain, typename ChainT::Data& data,
                                         const Eigen::MatrixBase<Q>& q) {
@@ -21,8 +30,18 @@ const typename ChainT::VectorQ& gravity(const ChainT& chain, typename ChainT::Da
   return data.gravity_forces;
 }
 
-/// \brief C(q, qdot) qdot (with_gravity = false, the paper's definition: qddot = g = 0) or
-/// C qdot + G (with_gravity = true, one pass instead of two). \return data.bias_forces
+/// \brief The velocity-product forces C(q, qdot) qdot of eq. 23: the RNE with qddot = g = 0
+/// (paper section III-D), or C qdot + G in one pass instead of two.
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model: its segments, gravity and inertia_rate.
+/// \param[in,out] data Its workspace, made by chain.make_data().
+/// \param[in] q The coordinates (dim chain.num_coordinates()).
+/// \param[in] qdot Their rates (dim chain.num_coordinates()).
+/// \param[in] with_gravity false: C qdot (the paper's definition); true: C qdot + G.
+/// \return C qdot (or C qdot + G), stored in data.bias_forces.
+/// \throws std::invalid_argument (DynamicChain only) if q or qdot has another size than the
+///   chain or data was made for another chain.
 template <class ChainT, class Q, class Qd>
 const typename ChainT::VectorQ& bias(const ChainT& chain, typename ChainT::Data& data,
                                      const Eigen::MatrixBase<Q>& q,

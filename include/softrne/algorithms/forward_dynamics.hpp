@@ -17,7 +17,18 @@ namespace softrne {
 /// (mass_matrix_and_bias); M is factorised by Cholesky in data.mass_factor (M itself stays
 /// in data.mass_matrix). Cost O(n nq) for M plus O(nq^3) for the factorisation. If M is not
 /// positive definite (it always is for positive masses), qddot is set to NaN.
-/// \return data.qddot
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model.
+/// \param[in,out] data Its workspace, made by chain.make_data(); also leaves M in
+///   data.mass_matrix, its factor in data.mass_factor and C qdot + G in data.nonlinear_forces.
+/// \param[in] q The coordinates (dim chain.num_coordinates()).
+/// \param[in] qdot Their rates (dim chain.num_coordinates()).
+/// \param[in] tau Every generalised force other than inertia and gravity (dim
+///   chain.num_coordinates()): \f$K_{prs}p - K q - K_d\dot q\f$ + effects in eq. 23.
+/// \return The accelerations, stored in data.qddot (NaN if M is not positive definite).
+/// \throws std::invalid_argument (DynamicChain only) if q, qdot or tau has another size than
+///   the chain or data was made for another chain.
 template <class ChainT, class Q, class Qd, class Tau>
 const typename ChainT::VectorQ& forward_dynamics(const ChainT& chain, typename ChainT::Data& data,
                                                  const Eigen::MatrixBase<Q>& q,

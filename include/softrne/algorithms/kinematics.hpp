@@ -39,7 +39,16 @@ Eigen::Matrix<typename V::Scalar, n, 1> segment_entries(const Eigen::MatrixBase<
 }  // namespace detail
 
 /// \brief Calls every segment's `calc(q, qdot)`: rotations, positions, Jacobians, their rates
-/// and inertias (paper section III-A). The other algorithms run on what this leaves in data.
+/// and inertias (paper section III-A, eqs. 1-10 and 19). The other algorithms run on what
+/// this leaves in data.
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model.
+/// \param[in,out] data Its workspace; the per-segment results go to data.kinematics.
+/// \param[in] q The coordinates (dim chain.num_coordinates()).
+/// \param[in] qdot Their rates (dim chain.num_coordinates()).
+/// \throws std::invalid_argument (DynamicChain only) if q or qdot has another size than the
+///   chain or data was made for another chain.
 template <class ChainT, class Q, class Qd>
 void compute_kinematics(const ChainT& chain, typename ChainT::Data& data,
                         const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot) {
@@ -57,12 +66,21 @@ void compute_kinematics(const ChainT& chain, typename ChainT::Data& data,
 /// \brief Placement of a segment's distal frame in the base frame of the chain.
 template <class Scalar>
 struct Placement {
+  /// Orientation: the distal frame's axes in base coordinates.
   Eigen::Matrix<Scalar, 3, 3> R = Eigen::Matrix<Scalar, 3, 3>::Identity();
+  /// Origin of the distal frame in the base frame.
   Eigen::Matrix<Scalar, 3, 1> p = Eigen::Matrix<Scalar, 3, 1>::Zero();
 };
 
 /// \brief Placement of the distal frame of segment `last` (default: the tip) after
-/// `compute_kinematics`.
+/// `compute_kinematics`: the product of the segments' rotations (eq. 2 for a CC joint) and
+/// shifts (eq. 4).
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model.
+/// \param[in] data Its workspace after compute_kinematics() (or any algorithm) at q.
+/// \param[in] last Index of the segment whose distal frame is wanted; negative: the tip.
+/// \return The frame's orientation and origin in the base frame.
 template <class ChainT>
 Placement<typename ChainT::Scalar> distal_placement(const ChainT& chain,
                                                     typename ChainT::Data& data, int last = -1) {

@@ -239,8 +239,18 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
 
 }  // namespace detail
 
-/// \brief M(q), symmetric positive definite (exactly symmetric). Uses data.mass_factor as
-/// workspace. \return data.mass_matrix
+/// \brief The joint-space inertia matrix M(q) of eq. 23, symmetric positive definite (exactly
+/// symmetric). Column k is what the paper's section III-D obtains from the RNE with
+/// qddot = e_k and qdot = g = 0, here in one composite-body sweep (see mass_matrix_passes).
+/// Uses data.mass_factor as workspace.
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model.
+/// \param[in,out] data Its workspace, made by chain.make_data().
+/// \param[in] q The coordinates (dim chain.num_coordinates()).
+/// \return M(q), stored in data.mass_matrix.
+/// \throws std::invalid_argument (DynamicChain only) if q has another size than the chain or
+///   data was made for another chain.
 template <class ChainT, class Q>
 const typename ChainT::MatrixQ& mass_matrix(const ChainT& chain, typename ChainT::Data& data,
                                             const Eigen::MatrixBase<Q>& q) {
@@ -252,7 +262,15 @@ const typename ChainT::MatrixQ& mass_matrix(const ChainT& chain, typename ChainT
 }
 
 /// \brief M(q) and C(q,qdot) qdot + G(q) from one kinematics evaluation: what forward dynamics
-/// needs. Results in data.mass_matrix and data.nonlinear_forces.
+/// (eq. 23) needs. Results in data.mass_matrix and data.nonlinear_forces.
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model.
+/// \param[in,out] data Its workspace, made by chain.make_data(); receives both results.
+/// \param[in] q The coordinates (dim chain.num_coordinates()).
+/// \param[in] qdot Their rates (dim chain.num_coordinates()).
+/// \throws std::invalid_argument (DynamicChain only) if q or qdot has another size than the
+///   chain or data was made for another chain.
 template <class ChainT, class Q, class Qd>
 void mass_matrix_and_bias(const ChainT& chain, typename ChainT::Data& data,
                           const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot) {

@@ -50,7 +50,22 @@ void rnea_passes(const ChainT& chain, typename ChainT::Data& data,
 /// \brief Inverse dynamics: the generalised forces \f$\tau = M(q)\ddot q + C(q,\dot q)\dot q +
 /// G(q)\f$ of the chain's inertia and gravity (springs, dampers and pressures are not part of
 /// it; see forward_dynamics.hpp). Cost: one kinematics pass and two O(n) recursions.
-/// \return data.tau
+///
+/// The forward recursion, base to tip, is the paper's eqs. 11-15 on the relative motion of
+/// eqs. 7-8 (a rigid link: eq. 10); the backward recursion, tip to base, is eqs. 16-18 (with
+/// the default InertiaRate::Consistent, eq. 18 gains the rate of the configuration-dependent
+/// inertia; see rnea_steps.hpp).
+///
+/// \tparam ChainT A Chain<...> or a DynamicChain<Scalar>.
+/// \param[in] chain The model: its segments, gravity (base frame) and inertia_rate.
+/// \param[in,out] data Its workspace, made by chain.make_data(); the result goes to data.tau.
+/// \param[in] q The coordinates (dim chain.num_coordinates(): u, v per CC joint, the angle
+///   of each revolute joint).
+/// \param[in] qdot Their rates (dim chain.num_coordinates()).
+/// \param[in] qddot The desired accelerations (dim chain.num_coordinates()).
+/// \return The generalised forces, stored in data.tau (valid until rnea() runs again on data).
+/// \throws std::invalid_argument (DynamicChain only, also in Release) if q, qdot or qddot has
+///   another size than the chain or data was made for another chain.
 template <class ChainT, class Q, class Qd, class Qdd>
 const typename ChainT::VectorQ& rnea(const ChainT& chain, typename ChainT::Data& data,
                                      const Eigen::MatrixBase<Q>& q,

@@ -27,17 +27,24 @@ struct DynamicChainData;
 template <class Scalar_>
 class DynamicChain {
  public:
-  using Scalar = Scalar_;
-  using VectorQ = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-  using MatrixQ = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  using Data = DynamicChainData<Scalar>;
-  using Segment = AnySegment<Scalar>;
+  using Scalar = Scalar_;  ///< double, long double or an automatic-differentiation type
+  using VectorQ = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;  ///< q, qdot, qddot, tau (dim nq)
+  using MatrixQ = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;  ///< M (nq x nq)
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;  ///< a 3-vector of the scalar type
+  using Data = DynamicChainData<Scalar>;        ///< the workspace type (make_data())
+  using Segment = AnySegment<Scalar>;  ///< a std::variant of every segment type
 
-  Vector3 gravity = Vector3(Scalar(0), Scalar(0), Scalar(-9.81));  ///< in the base frame
+  /// Gravitational acceleration \f$g^0\f$ in the base frame (eq. 16); for a hanging arm
+  /// (base z down) set it to (0, 0, 9.81).
+  Vector3 gravity = Vector3(Scalar(0), Scalar(0), Scalar(-9.81));
+  /// Whether the CC joints' inertia rate enters (Consistent, default) or not (PaperFrozen,
+  /// the paper's eq. 18).
   InertiaRate inertia_rate = InertiaRate::Consistent;
 
   /// \brief Appends a segment at the tip; `name` is used in messages and file columns.
+  /// \tparam S A segment type of AnySegment (ConstantCurvatureJoint, RigidLink, ...).
+  /// \param[in] segment The segment (copied into the chain).
+  /// \param[in] name Its name (robot files: the segment's "name").
   template <class S>
   void add(S segment, std::string name = {}) {
     offsets_.push_back(nq_);
@@ -46,18 +53,32 @@ class DynamicChain {
     names_.push_back(std::move(name));
   }
 
+  /// \return The number of segments, base to tip.
   int num_segments() const { return static_cast<int>(segments_.size()); }
+  /// \return nq, the size of q, qdot, qddot and tau.
   int num_coordinates() const { return nq_; }
+  /// \param[in] i A segment index. \return The index of segment i's first coordinate
+  /// in q.
   int q_offset(int i) const { return offsets_[static_cast<std::size_t>(i)]; }
+  /// \param[in] i A segment index (0 = base). \return Segment i.
   const Segment& segment(int i) const { return segments_[static_cast<std::size_t>(i)]; }
+  /// \param[in] i A segment index (0 = base). \return Segment i, to change its
+  /// constants (not while another thread evaluates the chain).
   Segment& segment(int i) { return segments_[static_cast<std::size_t>(i)]; }
+  /// \param[in] i A segment index. \return The name given to add().
   const std::string& name(int i) const { return names_[static_cast<std::size_t>(i)]; }
+  /// \return A workspace for this chain, sized once (one per thread); the
+  /// algorithms allocate nothing after it.
   Data make_data() const { return Data(*this); }
 
   /// \brief Throws std::invalid_argument naming the algorithm, the argument and both sizes
   /// unless `size` == num_coordinates(). Always on, also in Release: a runtime chain is built
   /// from a user's robot file, so its size is known only at run time (the compile-time
   /// Chain<...> checks fixed-size arguments when it compiles).
+  /// \param[in] algorithm The algorithm's name, for the message.
+  /// \param[in] argument The argument's name, for the message.
+  /// \param[in] size The argument's size.
+  /// \throws std::invalid_argument if size != num_coordinates().
   void check_argument(const char* algorithm, const char* argument, Eigen::Index size) const {
     if (size != nq_)
       throw std::invalid_argument(std::string("softrne::") + algorithm + ": " + argument + " has " +
@@ -66,6 +87,8 @@ class DynamicChain {
   }
   /// \brief Throws std::invalid_argument unless `data` was made by make_data() of a chain with
   /// this one's segments. Always on, like check_argument().
+  /// \param[in] data The workspace to check.
+  /// \throws std::invalid_argument if data has another number of segments or coordinates.
   void check_data(const Data& data) const {
     if (data.kinematics.size() != segments_.size() || static_cast<int>(data.tau.size()) != nq_)
       throw std::invalid_argument(
@@ -76,18 +99,27 @@ class DynamicChain {
   }
 
   /// \brief Calls f(segment, kinematics, index, q_offset) base to tip.
+  /// \param[in,out] data The workspace whose per-segment kinematics f receives.
+  /// \param[in] f A generic callable (each segment type is visited with its own type).
+  /// \throws std::invalid_argument if data was made for another chain.
   template <class F>
   void forward(Data& data, F&& f) const {
     check_data(data);
     for (int i = 0; i < num_segments(); ++i) visit(data, f, i);
   }
   /// \brief Calls f(segment, kinematics, index, q_offset) tip to base.
+  /// \param[in,out] data The workspace whose per-segment kinematics f receives.
+  /// \param[in] f A generic callable (each segment type is visited with its own type).
+  /// \throws std::invalid_argument if data was made for another chain.
   template <class F>
   void backward(Data& data, F&& f) const {
     check_data(data);
     for (int i = num_segments() - 1; i >= 0; --i) visit(data, f, i);
   }
 
+  /// \brief The same chain in another scalar type (e.g. an AutoDiff scalar for derivatives).
+  /// \tparam NewScalar The new scalar type.
+  /// \return A copy with every constant converted.
   template <class NewScalar>
   DynamicChain<NewScalar> cast() const {
     DynamicChain<NewScalar> c;
@@ -125,24 +157,42 @@ class DynamicChain {
 /// \brief Per-evaluation workspace of a runtime chain, sized once by the chain.
 template <class Scalar>
 struct DynamicChainData {
-  using VectorQ = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-  using MatrixQ = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  using VectorQ = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;  ///< as DynamicChain::VectorQ
+  using MatrixQ = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;  ///< as the chain's
 
+  /// Per segment: what compute_kinematics() computed (rotations, Jacobians, inertias).
   std::vector<AnySegmentKinematics<Scalar>> kinematics;
-  std::vector<FrameMotion<Scalar>> motion;
-  std::vector<BodyLoad<Scalar>> loads;
-  std::vector<Wrench<Scalar>> wrench;
+  std::vector<FrameMotion<Scalar>> motion;  ///< [0] base, [i+1] distal frame of segment i
+  std::vector<BodyLoad<Scalar>> loads;      ///< per segment: its own body's load
+  std::vector<Wrench<Scalar>> wrench;  ///< [i] at the base of segment i, [N] at the tip
   /// One output field per algorithm (as Pinocchio's data.tau, data.g, data.nle): rnea ->
   /// tau, gravity -> gravity_forces, bias -> bias_forces, mass_matrix_and_bias and aba ->
   /// nonlinear_forces (C qdot + G), aba and forward_dynamics -> qddot.
   VectorQ tau, gravity_forces, bias_forces, nonlinear_forces, qdot_zero, unit, qddot;
-  MatrixQ mass_matrix;
+  /// \var tau
+  /// \brief Output of rnea(): \f$M\ddot q + C\dot q + G\f$.
+  /// \var gravity_forces
+  /// \brief Output of gravity(): G(q).
+  /// \var bias_forces
+  /// \brief Output of bias(): C(q, qdot) qdot (+ G with with_gravity).
+  /// \var nonlinear_forces
+  /// \brief Output of mass_matrix_and_bias(), forward_dynamics() and aba(): C qdot + G.
+  /// \var qdot_zero
+  /// \brief Scratch: a zero velocity (gravity(), mass_matrix()).
+  /// \var unit
+  /// \brief Scratch: a unit vector.
+  /// \var qddot
+  /// \brief Output of forward_dynamics() and aba(): the accelerations.
+  MatrixQ mass_matrix;  ///< output of mass_matrix() and mass_matrix_and_bias(): M(q)
   MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
-  /// Per-segment scratch of aba (articulated_body.hpp), one per segment.
+  /// Largest nq of a segment type (sizes `articulated`).
   static constexpr int max_segment_nq = detail::variant_max_nq<AnySegment<Scalar>>::value;
+  /// Per-segment scratch of aba (articulated_body.hpp), one per segment.
   std::vector<ArticulatedSegment<Scalar, max_segment_nq>> articulated;
 
   DynamicChainData() = default;
+  /// \brief Sized for `chain` (what chain.make_data() returns).
+  /// \param[in] chain The chain this workspace serves.
   explicit DynamicChainData(const DynamicChain<Scalar>& chain) {
     const auto n = static_cast<std::size_t>(chain.num_segments());
     const int nq = chain.num_coordinates();
@@ -167,6 +217,7 @@ struct DynamicChainData {
     mass_matrix = MatrixQ::Zero(nq, nq);
     mass_factor = MatrixQ::Zero(nq, nq);
   }
+  /// \return The number of segments of the chain this was made for.
   int num_segments() const { return static_cast<int>(kinematics.size()); }
 };
 

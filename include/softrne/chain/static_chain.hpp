@@ -29,31 +29,43 @@ class Chain {
   static_assert(sizeof...(Segments) > 0, "softrne::Chain needs at least one segment");
 
  public:
+  /// The segments' common scalar type (double, long double, an AutoDiff type).
   using Scalar = typename std::tuple_element_t<0, std::tuple<Segments...>>::Scalar;
   static_assert((std::is_same_v<Scalar, typename Segments::Scalar> && ...),
                 "softrne::Chain: all segments must use the same Scalar type");
-  static constexpr int num_segments = static_cast<int>(sizeof...(Segments));
-  static constexpr int nq = (0 + ... + Segments::nq);
-  using VectorQ = Eigen::Matrix<Scalar, nq, 1>;
-  using MatrixQ = Eigen::Matrix<Scalar, nq, nq>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  using Data = ChainData<Chain>;
+  static constexpr int num_segments = static_cast<int>(sizeof...(Segments));  ///< base to tip
+  static constexpr int nq = (0 + ... + Segments::nq);  ///< number of coordinates
+  using VectorQ = Eigen::Matrix<Scalar, nq, 1>;        ///< q, qdot, qddot, tau (fixed size)
+  using MatrixQ = Eigen::Matrix<Scalar, nq, nq>;       ///< M (fixed size)
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;         ///< a 3-vector of the scalar type
+  using Data = ChainData<Chain>;                       ///< the workspace type (make_data())
 
-  std::tuple<Segments...> segments;
-  Vector3 gravity = Vector3(Scalar(0), Scalar(0), Scalar(-9.81));  ///< in the base frame
+  std::tuple<Segments...> segments;  ///< the segments, base to tip (constants only)
+  /// Gravitational acceleration \f$g^0\f$ in the base frame (eq. 16); for a hanging arm
+  /// (base z down) set it to (0, 0, 9.81).
+  Vector3 gravity = Vector3(Scalar(0), Scalar(0), Scalar(-9.81));
+  /// Whether the CC joints' inertia rate enters (Consistent, default) or not (PaperFrozen,
+  /// the paper's eq. 18).
   InertiaRate inertia_rate = InertiaRate::Consistent;
 
+  /// \brief Default-constructed segments.
   Chain() { (check_segment<Segments>(), ...); }
+  /// \brief The chain of these segments, base to tip.
+  /// \param[in] segs One segment per type, in order.
   explicit Chain(Segments... segs) : segments(std::move(segs)...) {
     (check_segment<Segments>(), ...);
   }
 
+  /// \return nq, the size of q, qdot, qddot and tau.
   int num_coordinates() const { return nq; }
+  /// \return A workspace for this chain (one per thread); the algorithms allocate nothing.
   Data make_data() const { return Data(*this); }
 
   /// \brief A fixed-size argument of another size does not compile (detail::check_argument);
   /// a dynamic-size one (a VectorXd passed to a fixed chain) is checked in debug builds, as
   /// Eigen checks sizes. The hot path of a controller pays nothing.
+  /// \param[in] size The argument's size (the algorithm's and the argument's names are
+  ///   unused here; DynamicChain::check_argument puts them in its message).
   void check_argument(const char*, const char*, Eigen::Index size) const {
     SOFTRNE_ASSERT(size == nq, "softrne::Chain: an argument's size is not the chain's nq");
     (void)size;
@@ -61,7 +73,9 @@ class Chain {
   /// \brief Nothing to check: the Data type belongs to this chain type alone.
   void check_data(const Data&) const {}
 
-  /// Offset of segment I's coordinates in q.
+  /// \brief Offset of segment I's coordinates in q.
+  /// \tparam I A segment index.
+  /// \return The index of segment I's first coordinate.
   template <std::size_t I>
   static constexpr int q_offset() {
     constexpr int sizes[] = {Segments::nq...};
@@ -71,16 +85,23 @@ class Chain {
   }
 
   /// \brief Calls f(segment, kinematics, index, q_offset) base to tip.
+  /// \param[in,out] data The workspace whose per-segment kinematics f receives.
+  /// \param[in] f A generic callable (each segment with its own type; no virtual call).
   template <class DataT, class F>
   void forward(DataT& data, F&& f) const {
     forward_impl(data, f, std::index_sequence_for<Segments...>{});
   }
   /// \brief Calls f(segment, kinematics, index, q_offset) tip to base.
+  /// \param[in,out] data The workspace whose per-segment kinematics f receives.
+  /// \param[in] f A generic callable (each segment with its own type; no virtual call).
   template <class DataT, class F>
   void backward(DataT& data, F&& f) const {
     backward_impl(data, f, std::index_sequence_for<Segments...>{});
   }
 
+  /// \brief The same chain in another scalar type (e.g. an AutoDiff scalar for derivatives).
+  /// \tparam NewScalar The new scalar type.
+  /// \return A Chain of the converted segments.
   template <class NewScalar>
   auto cast() const {
     return cast_impl<NewScalar>(std::index_sequence_for<Segments...>{});
@@ -112,24 +133,40 @@ class Chain {
 /// \brief Per-evaluation workspace of a compile-time chain: everything the algorithms write.
 template <class... Segments>
 struct ChainData<Chain<Segments...>> {
-  using ChainT = Chain<Segments...>;
-  using Scalar = typename ChainT::Scalar;
-  static constexpr int N = ChainT::num_segments;
+  using ChainT = Chain<Segments...>;        ///< the chain this workspace serves
+  using Scalar = typename ChainT::Scalar;   ///< its scalar type
+  static constexpr int N = ChainT::num_segments;  ///< its number of segments
 
+  /// Per segment: what compute_kinematics() computed (rotations, Jacobians, inertias).
   std::tuple<typename Segments::Kinematics...> kinematics;
   std::array<FrameMotion<Scalar>, N + 1> motion;  ///< [0] base, [i+1] distal frame of segment i
-  std::array<BodyLoad<Scalar>, N> loads;
+  std::array<BodyLoad<Scalar>, N> loads;  ///< per segment: its own body's load
   std::array<Wrench<Scalar>, N + 1> wrench;  ///< [i] at the base of segment i, [N] at the tip
   /// One output field per algorithm (as Pinocchio's data.tau, data.g, data.nle): rnea ->
   /// tau, gravity -> gravity_forces, bias -> bias_forces, mass_matrix_and_bias and aba ->
   /// nonlinear_forces (C qdot + G), aba and forward_dynamics -> qddot.
   typename ChainT::VectorQ tau, gravity_forces, bias_forces, nonlinear_forces, qdot_zero, unit, qddot;
-  typename ChainT::MatrixQ mass_matrix;
+  /// \var tau
+  /// \brief Output of rnea(): \f$M\ddot q + C\dot q + G\f$.
+  /// \var gravity_forces
+  /// \brief Output of gravity(): G(q).
+  /// \var bias_forces
+  /// \brief Output of bias(): C(q, qdot) qdot (+ G with with_gravity).
+  /// \var nonlinear_forces
+  /// \brief Output of mass_matrix_and_bias(), forward_dynamics() and aba(): C qdot + G.
+  /// \var qdot_zero
+  /// \brief Scratch: a zero velocity (gravity(), mass_matrix()).
+  /// \var unit
+  /// \brief Scratch: a unit vector.
+  /// \var qddot
+  /// \brief Output of forward_dynamics() and aba(): the accelerations.
+  typename ChainT::MatrixQ mass_matrix;  ///< output of mass_matrix(): M(q)
   typename ChainT::MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
   /// Per-segment scratch of aba (articulated_body.hpp).
   std::array<ArticulatedSegment<Scalar, detail::max_segment_nq<Segments...>()>, N> articulated;
 
   ChainData() = default;
+  /// \brief Zero-initialised (what chain.make_data() returns); the chain's type sizes it.
   explicit ChainData(const ChainT&) {
     tau.setZero();
     gravity_forces.setZero();
@@ -140,6 +177,7 @@ struct ChainData<Chain<Segments...>> {
     qddot.setZero();
     mass_matrix.setZero();
   }
+  /// \return N, the number of segments.
   int num_segments() const { return N; }
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
