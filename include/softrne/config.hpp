@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <cstdlib>
 
-#define SOFTRNE_VERSION_MAJOR 0
-#define SOFTRNE_VERSION_MINOR 1
-#define SOFTRNE_VERSION_PATCH 0
+#define SOFTRNE_VERSION_MAJOR 0  ///< Major version (the CMake project's VERSION).
+#define SOFTRNE_VERSION_MINOR 1  ///< Minor version.
+#define SOFTRNE_VERSION_PATCH 0  ///< Patch version.
 
 /// \brief Debug-build check of API preconditions (sizes, a Data made for another chain).
 /// Prints file:line and the message, then aborts; compiled out with NDEBUG.
@@ -55,6 +55,8 @@
 #define SOFTRNE_SIM_BODIES 0
 #else
 #define SOFTRNE_SIM_INLINE inline
+/// \brief 1 where the sim/ entry points' bodies are compiled (header-only mode, or
+/// src/sim.cpp), 0 where only their declarations are seen (SOFTRNE_USE_COMPILED).
 #define SOFTRNE_SIM_BODIES 1
 #endif
 
@@ -65,6 +67,10 @@
 #define SOFTRNE_FIT_INLINE
 #define SOFTRNE_FIT_BODIES 0
 #else
+/// \brief `inline` in header-only mode, nothing where fit/'s entry points are compiled once
+/// (see SOFTRNE_SIM_INLINE).
 #define SOFTRNE_FIT_INLINE inline
+/// \brief 1 where fit/'s entry points' bodies are compiled, 0 where only their declarations
+/// are seen (see SOFTRNE_SIM_BODIES).
 #define SOFTRNE_FIT_BODIES 1
 #endif

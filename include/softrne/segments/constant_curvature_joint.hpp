@@ -21,7 +21,7 @@ namespace softrne {
 /// \brief Inertia model of a CC joint: the paper's one lumped body (eqs. 9, 14, 18-19). The
 /// default.
 struct LumpedInertia {
-  static constexpr int num_points = 0;
+  static constexpr int num_points = 0;  ///< no quadrature disks: one lumped body
 };
 
 /// \brief Default number of Gauss-Legendre points of DistributedInertia: the smallest with
@@ -36,7 +36,7 @@ inline constexpr int kDefaultGaussPoints = 6;
 template <int NG = kDefaultGaussPoints>
 struct DistributedInertia {
   static_assert(NG >= 1, "DistributedInertia needs at least one point");
-  static constexpr int num_points = NG;
+  static constexpr int num_points = NG;  ///< quadrature disks along the arc
 };
 
 namespace detail {
@@ -107,20 +107,21 @@ struct GaussLegendre01 {
 /// Kinematics of the distal frame are the same for both.
 template <class Scalar_, class InertiaModel = LumpedInertia>
 struct ConstantCurvatureJoint {
-  using Scalar = Scalar_;
-  using Inertia = InertiaModel;
-  static constexpr int nq = 2;
-  static constexpr bool has_body = true;
-  static constexpr int max_chambers = 8;
+  using Scalar = Scalar_;       ///< double, long double or an AutoDiff type
+  using Inertia = InertiaModel;  ///< LumpedInertia or DistributedInertia<NG>
+  static constexpr int nq = 2;   ///< the bending angles u, v (eq. 1)
+  static constexpr bool has_body = true;  ///< it carries mass
+  static constexpr int max_chambers = 8;  ///< most pressure inputs (columns of K_prs)
   /// Quadrature disks (0: lumped).
   static constexpr int num_points = InertiaModel::num_points;
-  static constexpr bool distributed = num_points > 0;
+  static constexpr bool distributed = num_points > 0;  ///< the disks are sub-bodies
+  /// What calc() fills: one lumped body, or the disks as sub-bodies.
   using Kinematics = std::conditional_t<distributed, MultiBodyKinematics<Scalar, nq, num_points>,
                                         SegmentKinematics<Scalar, nq>>;
-  using Vector2 = Eigen::Matrix<Scalar, 2, 1>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  using Vector6 = Eigen::Matrix<Scalar, 6, 1>;
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+  using Vector2 = Eigen::Matrix<Scalar, 2, 1>;  ///< a 2-vector (q, qdot, forces)
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;  ///< a 3-vector
+  using Vector6 = Eigen::Matrix<Scalar, 6, 1>;  ///< a 6-vector (linear; angular)
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;  ///< a 3x3 matrix
   /// 2 x K map from chamber pressures to (tau_u, tau_v); at most max_chambers columns, stored
   /// inline (no heap).
   using PressureMap = Eigen::Matrix<Scalar, 2, Eigen::Dynamic, 0, 2, max_chambers>;
@@ -134,6 +135,9 @@ struct ConstantCurvatureJoint {
 
   /// \brief Eq. 24: four chambers at distance d from the axis with radius delta,
   /// \f$\tau_u = dA(p_0-p_1)\f$, \f$\tau_v = dA(p_2-p_3)\f$, \f$A = \pi\delta^2\f$.
+  /// \param[in] chamber_distance d, from the joint's axis to a chamber's centre, m.
+  /// \param[in] chamber_radius delta, a chamber's radius, m.
+  /// \return K_prs (2 x 4), N m/Pa.
   static PressureMap four_chamber_map(const Scalar& chamber_distance,
                                       const Scalar& chamber_radius) {
     const Scalar dA = chamber_distance * Scalar(M_PI) * chamber_radius * chamber_radius;
@@ -142,9 +146,13 @@ struct ConstantCurvatureJoint {
     return K;
   }
 
+  /// \return The number of chambers (pressure inputs), the columns of pressure_to_torque.
   int num_inputs() const { return static_cast<int>(pressure_to_torque.cols()); }
 
   /// \brief Linear spring and damper of eq. 23: \f$-K_{spring} q - K_d \dot q\f$.
+  /// \param[in] q The joint's (u, v), rad.
+  /// \param[in] qdot Their rates, rad/s.
+  /// \return The generalised force (tau_u, tau_v), N m.
   template <class Q, class Qd>
   Vector2 passive_force(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot) const {
     return -(stiffness.cwiseProduct(q) + damping.cwiseProduct(qdot));
@@ -154,6 +162,12 @@ struct ConstantCurvatureJoint {
   ///
   /// Written out per component: with w = (u, v, 0) every product of [w]x with itself or
   /// with e_z has a closed form, so no 3x3 matrix product is formed.
+  ///
+  /// Eqs. 1-9 (rotation, distal position, Jacobian, its rate, centre of mass) and the
+  /// lumped inertia of eq. 19, or the disks of DistributedInertia (eqs. 19-22 integrated).
+  /// \param[in] q (u, v), rad.
+  /// \param[in] qdot (u', v'), rad/s (for the Jacobian rates and the inertia rate).
+  /// \param[out] kin The segment's kinematics.
   template <class Q, class Qd>
   void calc(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
             Kinematics& kin) const {
@@ -179,11 +193,16 @@ struct ConstantCurvatureJoint {
   }
 
   /// \brief Generalised forces of the chamber pressures (eq. 24 or a custom layout).
+  /// \param[in] pressures One pressure per chamber (num_inputs()), Pa.
+  /// \return \f$K_{prs}p\f$ = (tau_u, tau_v), N m.
   template <class P>
   Vector2 actuation(const Eigen::MatrixBase<P>& pressures) const {
     return pressure_to_torque * pressures;
   }
 
+  /// \brief The same joint in another scalar type.
+  /// \tparam NewScalar The new scalar type.
+  /// \return A copy with every constant converted.
   template <class NewScalar>
   ConstantCurvatureJoint<NewScalar, InertiaModel> cast() const {
     ConstantCurvatureJoint<NewScalar, InertiaModel> c;
@@ -197,6 +216,8 @@ struct ConstantCurvatureJoint {
   }
 
   /// \brief The same joint (parameters) with another inertia model.
+  /// \tparam NewModel LumpedInertia or DistributedInertia<NG>.
+  /// \return A copy with the same constants.
   template <class NewModel>
   ConstantCurvatureJoint<Scalar, NewModel> with_inertia() const {
     ConstantCurvatureJoint<Scalar, NewModel> c;
@@ -212,6 +233,19 @@ struct ConstantCurvatureJoint {
   /// \brief Pose, Jacobians and their rates of the distal frame of an arc of height h at
   /// (u, v) with velocity (ud, vd), from the functions f at \f$u^2+v^2\f$; with kWithCom also
   /// the centre of mass of the arc (eq. 9). Used for the segment and for each quadrature disk.
+  /// \param[in] f The CC functions of \f$\phi^2 = u^2+v^2\f$ (eqs. 1-5).
+  /// \param[in] u Bending angle about x, rad.
+  /// \param[in] v Bending angle about y, rad.
+  /// \param[in] ud Rate of u.
+  /// \param[in] vd Rate of v.
+  /// \param[in] height The arc's height (length) h, m.
+  /// \param[out] R Distal orientation (eq. 2).
+  /// \param[out] r_e Distal position (eq. 4).
+  /// \param[out] J_e Distal geometric Jacobian (eqs. 5-6).
+  /// \param[out] Jdot_qdot_e \f$\dot J\dot q\f$ (eq. 8).
+  /// \param[out] r_c Centre of mass (eq. 9; kWithCom only).
+  /// \param[out] J_c \f$\partial r_c/\partial q\f$ (kWithCom only).
+  /// \param[out] Jdot_qdot_c Its rate times qdot (kWithCom only).
   template <bool kWithCom, class JE, class JC>
   static void arc_kinematics(const detail::CCFunctions<Scalar>& f, const Scalar& u,
                              const Scalar& v, const Scalar& ud, const Scalar& vd,

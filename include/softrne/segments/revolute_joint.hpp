@@ -16,27 +16,35 @@ namespace softrne {
 /// around it (formats.md, `revolute_joint`).
 template <class Scalar_>
 struct RevoluteJoint {
-  using Scalar = Scalar_;
-  static constexpr int nq = 1;
-  static constexpr bool has_body = false;
-  using Kinematics = SegmentKinematics<Scalar, nq>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+  using Scalar = Scalar_;                 ///< double, long double or an AutoDiff type
+  static constexpr int nq = 1;            ///< the joint angle
+  static constexpr bool has_body = false; ///< massless
+  using Kinematics = SegmentKinematics<Scalar, nq>;  ///< what calc() fills
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;       ///< a 3-vector
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;       ///< a 3x3 matrix
 
-  Vector3 axis = Vector3::UnitZ();
+  Vector3 axis = Vector3::UnitZ();  ///< rotation axis, unit, in the base frame
   Scalar stiffness{0};  ///< N m/rad
   Scalar damping{0};    ///< N m s/rad
   Scalar mass{0};       ///< always zero; present so every segment answers `mass`
 
-  /// \brief \f$-k q - d \dot q\f$.
+  /// \brief The joint's spring and damper, \f$-k q - d \dot q\f$ (eq. 23's K_spring, K_d).
+  /// \param[in] q The joint angle, rad.
+  /// \param[in] qdot Its rate, rad/s.
+  /// \return The generalised force, N m.
   template <class Q, class Qd>
   Eigen::Matrix<Scalar, 1, 1> passive_force(const Eigen::MatrixBase<Q>& q,
                                             const Eigen::MatrixBase<Qd>& qdot) const {
     return Eigen::Matrix<Scalar, 1, 1>(-(stiffness * q(0) + damping * qdot(0)));
   }
 
+  /// \return 0: no pressure inputs.
   int num_inputs() const { return 0; }
 
+  /// \brief Fills kin for the angle q: the rotation about axis (Rodrigues), a constant
+  /// Jacobian (angular part = axis) and a zero Jacobian rate.
+  /// \param[in] q The joint angle, rad (the velocity is not needed).
+  /// \param[out] kin The segment's kinematics.
   template <class Q, class Qd>
   void calc(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>&, Kinematics& kin) const {
     using std::cos;
@@ -63,6 +71,9 @@ struct RevoluteJoint {
     kin.J_distal.template bottomRows<3>() = axis;
   }
 
+  /// \brief The same joint in another scalar type.
+  /// \tparam NewScalar The new scalar type.
+  /// \return A copy with every constant converted.
   template <class NewScalar>
   RevoluteJoint<NewScalar> cast() const {
     RevoluteJoint<NewScalar> j;

@@ -13,27 +13,32 @@ namespace softrne {
 /// (0, 0, length), not rotated. No coordinates, so its Jacobians are empty (paper eq. 10).
 template <class Scalar_>
 struct RigidLink {
-  using Scalar = Scalar_;
-  static constexpr int nq = 0;
-  static constexpr bool has_body = true;
-  using Kinematics = SegmentKinematics<Scalar, nq>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+  using Scalar = Scalar_;                 ///< double, long double or an AutoDiff type
+  static constexpr int nq = 0;            ///< no coordinates
+  static constexpr bool has_body = true;  ///< it carries mass
+  using Kinematics = SegmentKinematics<Scalar, nq>;  ///< what calc() fills
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;       ///< a 3-vector
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;       ///< a 3x3 matrix
 
-  Scalar mass{1};
-  Scalar length{0};
-  Vector3 com = Vector3::Zero();
+  Scalar mass{1};                 ///< m, kg
+  Scalar length{0};               ///< distal frame at (0, 0, length) in the base frame, m
+  Vector3 com = Vector3::Zero();  ///< centre of mass in the link (base) frame, m
   Matrix3 inertia = Matrix3::Zero();  ///< about the centre of mass, in the link frame
 
+  /// \return 0: no pressure inputs.
   int num_inputs() const { return 0; }
 
+  /// \brief No coordinates, so no spring or damper force.
+  /// \return An empty vector.
   template <class Q, class Qd>
   Eigen::Matrix<Scalar, 0, 1> passive_force(const Eigen::MatrixBase<Q>&,
                                             const Eigen::MatrixBase<Qd>&) const {
     return {};
   }
 
-  /// The kinematics do not depend on q: calc only writes the constant fields.
+  /// \brief The kinematics do not depend on q: calc only writes the constant fields (the
+  /// relative motion is zero, eq. 10).
+  /// \param[out] kin The segment's kinematics.
   template <class Q, class Qd>
   void calc(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<Qd>&, Kinematics& kin) const {
     kin.R_base_distal.setIdentity();
@@ -42,6 +47,9 @@ struct RigidLink {
     kin.inertia_com = inertia;
   }
 
+  /// \brief The same link in another scalar type.
+  /// \tparam NewScalar The new scalar type.
+  /// \return A copy with every constant converted.
   template <class NewScalar>
   RigidLink<NewScalar> cast() const {
     RigidLink<NewScalar> l;

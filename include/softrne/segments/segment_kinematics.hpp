@@ -16,9 +16,9 @@ namespace softrne {
 /// Filled by the segment's `calc`; read by the algorithms. Fixed size: no allocation.
 template <class Scalar, int NQ>
 struct SegmentKinematics {
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  using Vector6 = Eigen::Matrix<Scalar, 6, 1>;
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;  ///< a 3x3 matrix
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;  ///< a 3-vector
+  using Vector6 = Eigen::Matrix<Scalar, 6, 1>;  ///< a 6-vector (linear; angular)
   /// Rigid sub-bodies the own mass is made of (0: one lumped body described below, if any;
   /// see MultiBodyKinematics in sub_bodies.hpp).
   static constexpr int num_sub_bodies = 0;
@@ -36,7 +36,7 @@ struct SegmentKinematics {
   Vector6 Jdot_qdot_distal = Vector6::Zero();
   /// Linear-velocity Jacobian of the centre of mass, \f$\partial r_c/\partial q\f$.
   Eigen::Matrix<Scalar, 3, NQ> J_com = Eigen::Matrix<Scalar, 3, NQ>::Zero();
-  Vector3 Jdot_qdot_com = Vector3::Zero();
+  Vector3 Jdot_qdot_com = Vector3::Zero();  ///< \f$\dot J_{com}\dot q\f$ at calc's velocity
 
   /// Inertia about the centre of mass, in the distal frame (eq. 19); the body is taken to
   /// rotate with the distal frame (the paper's lumped model).
@@ -46,6 +46,7 @@ struct SegmentKinematics {
   /// \f$\dot I_c = \sum_k \partial I_c/\partial q_k\,\dot q_k\f$ at the velocity given to calc.
   Matrix3 inertia_rate = Matrix3::Zero();
 
+  /// \return NQ zero 3x3 matrices (the initial value of dinertia_dq).
   static std::array<Matrix3, static_cast<std::size_t>(NQ)> zero_matrices() {
     std::array<Matrix3, static_cast<std::size_t>(NQ)> a;
     for (auto& m : a) m.setZero();

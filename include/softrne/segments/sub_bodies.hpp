@@ -17,17 +17,17 @@ namespace softrne {
 /// relative to the base frame (with their time derivatives along qdot).
 template <class Scalar, int NQ>
 struct SubBodyKinematics {
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  Scalar mass{0};
-  Matrix3 R_base_body = Matrix3::Identity();
-  Vector3 r_base_body = Vector3::Zero();
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;  ///< a 3x3 matrix
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;  ///< a 3-vector
+  Scalar mass{0};                              ///< kg
+  Matrix3 R_base_body = Matrix3::Identity();   ///< the sub-body's orientation
+  Vector3 r_base_body = Vector3::Zero();       ///< its centre
   /// About the sub-body's centre, in base axes (\f$R I_{body} R^T\f$).
   Matrix3 inertia = Matrix3::Zero();
-  Eigen::Matrix<Scalar, 3, NQ> J_v = Eigen::Matrix<Scalar, 3, NQ>::Zero();
-  Eigen::Matrix<Scalar, 3, NQ> J_w = Eigen::Matrix<Scalar, 3, NQ>::Zero();
-  Vector3 Jdot_qdot_v = Vector3::Zero();
-  Vector3 Jdot_qdot_w = Vector3::Zero();
+  Eigen::Matrix<Scalar, 3, NQ> J_v = Eigen::Matrix<Scalar, 3, NQ>::Zero();  ///< of its centre
+  Eigen::Matrix<Scalar, 3, NQ> J_w = Eigen::Matrix<Scalar, 3, NQ>::Zero();  ///< angular
+  Vector3 Jdot_qdot_v = Vector3::Zero();  ///< \f$\dot J_v\dot q\f$
+  Vector3 Jdot_qdot_w = Vector3::Zero();  ///< \f$\dot J_\omega\dot q\f$
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
@@ -38,7 +38,8 @@ struct SubBodyKinematics {
 template <class Scalar, int NQ, int NB>
 struct MultiBodyKinematics : SegmentKinematics<Scalar, NQ> {
   static_assert(NB > 0, "MultiBodyKinematics needs at least one sub-body");
-  static constexpr int num_sub_bodies = NB;
+  static constexpr int num_sub_bodies = NB;  ///< how many sub-bodies
+  /// The sub-bodies (for a DistributedInertia CC joint: the quadrature disks).
   std::array<SubBodyKinematics<Scalar, NQ>, static_cast<std::size_t>(NB)> sub_bodies;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };

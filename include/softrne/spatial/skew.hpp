@@ -6,7 +6,10 @@
 
 namespace softrne {
 
-/// \brief \f$[w]_\times\f$ such that \f$[w]_\times x = w \times x\f$.
+/// \brief \f$[w]_\times\f$ such that \f$[w]_\times x = w \times x\f$ (the paper's \f$[\,]_x\f$
+/// of eqs. 6 and 19).
+/// \param[in] w A 3-vector.
+/// \return The 3x3 skew-symmetric matrix of w.
 template <class Derived>
 Eigen::Matrix<typename Derived::Scalar, 3, 3> skew(const Eigen::MatrixBase<Derived>& w) {
   using S = typename Derived::Scalar;
