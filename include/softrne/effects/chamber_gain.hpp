@@ -14,11 +14,20 @@ namespace softrne {
 /// Kind `gain` (dimensionless, neutral 1), per chamber (or one per joint, or shared). It
 /// commutes with actuator_lag (both linear), which ArmDynamics applies first.
 struct ChamberGain : Effect<ChamberGain> {
+  /// The effect's name in robot files, reports and `--effects`.
   static constexpr const char* name = "chamber_gain";
+  /// Its parameter kinds: name, plausible range, log scale, neutral value, unit.
   static constexpr std::array<ParamInfo, 1> param_info{{{"gain", 0.05, 2.0, false, 1.0, "1"}}};
+  /// The scopes it may have (the closed loop tries each).
   static constexpr std::array<Scope, 3> scopes{Scope::Shared, Scope::PerJoint, Scope::PerChamber};
+  /// \brief Which joints it can act on.
+  /// \param[in] j A joint of the arm.
+  /// \return True if it can act on j.
   static bool applies_to(const ArmJoint& j) { return j.num_inputs > 0; }
 
+  /// \brief Changes the pressures that drive the joints (the hook of EffectBase).
+  /// \param[in] arm The arm's joint table.
+  /// \param[in,out] p The pressures, Pa: recorded on entry, effective on return.
   template <class S, class X, class P>
   void effective_pressures(const std::vector<ArmJoint>& arm, const X&, P& p) const {
     for (std::size_t i = 0; i < joints.size(); ++i) {

@@ -19,6 +19,8 @@ namespace softrne {
 enum class Scope { Shared, PerJoint, PerCoordinate, PerChamber };
 
 /// \brief "shared", "joint", "coordinate", "chamber" (used in messages and reports).
+/// \param[in] s A scope.
+/// \return Its name in robot files and reports.
 inline const char* scope_name(Scope s) {
   switch (s) {
     case Scope::Shared: return "shared";
@@ -37,25 +39,30 @@ inline const char* scope_name(Scope s) {
 /// mass (effect_param_bounds multiplies them by it); a payload's plausible range scales with
 /// the arm that carries it. `neutral` is never scaled.
 struct ParamInfo {
-  const char* name;
+  const char* name;  ///< name in robot files and reports (e.g. "T")
   double lower, upper;
-  bool log_scale;
-  double neutral;
-  const char* unit;
-  bool per_arm_mass = false;
+  /// \var lower
+  /// \brief Smallest plausible value (per kg of arm mass if per_arm_mass).
+  /// \var upper
+  /// \brief Largest plausible value (per kg of arm mass if per_arm_mass).
+  bool log_scale;  ///< the fit searches log(value)
+  double neutral;  ///< the value at which the effect does nothing
+  const char* unit;  ///< SI unit, for reports
+  bool per_arm_mass = false;  ///< lower and upper scale with the arm's mass
 };
 
 /// \brief What an effect knows of one joint with coordinates (a CC joint or a revolute joint).
 struct ArmJoint {
-  std::string name;
+  std::string name;      ///< the segment's name in the robot file
   int segment = 0;       ///< index in the chain
   int q_offset = 0;      ///< first coordinate
   int nq = 0;            ///< 2 (CC) or 1 (revolute)
   int input_offset = 0;  ///< first pressure column
   int num_inputs = 0;    ///< chambers (0 for a revolute joint)
   Eigen::Vector2d stiffness = Eigen::Vector2d::Zero();  ///< first nq entries used
-  Eigen::Vector2d damping = Eigen::Vector2d::Zero();
+  Eigen::Vector2d damping = Eigen::Vector2d::Zero();  ///< first nq entries used
   Eigen::Matrix<double, 2, Eigen::Dynamic> pressure_to_torque;  ///< 2 x num_inputs (CC)
+  /// \return True for a CC joint (two coordinates), false for a revolute joint.
   bool is_cc() const { return nq == 2; }
 };
 
@@ -69,10 +76,12 @@ struct ArmJoint {
 /// parameter kinds contiguously: `params(unit * num_kinds + kind)`.
 struct EffectBase {
   std::vector<int> joints;  ///< indices into the arm's joint table
-  Scope scope = Scope::Shared;
-  Eigen::VectorXd params;
+  Scope scope = Scope::Shared;  ///< how many values each parameter kind has
+  Eigen::VectorXd params;       ///< the values, in the layout above
 
-  /// Number of units (see the layout above) on the arm's joint table.
+  /// \brief Number of units (see the layout above) on the arm's joint table.
+  /// \param[in] arm The arm's joint table.
+  /// \return 1 (Shared), one per listed joint, per coordinate or per chamber of them.
   int num_units(const std::vector<ArmJoint>& arm) const {
     switch (scope) {
       case Scope::Shared: return 1;
@@ -87,8 +96,12 @@ struct EffectBase {
     return 0;
   }
 
-  /// Unit of the i-th listed joint; `sub` is the coordinate (PerCoordinate) or chamber
+  /// \brief Unit of the i-th listed joint; `sub` is the coordinate (PerCoordinate) or chamber
   /// (PerChamber) within the joint, ignored otherwise. O(i): effects visit few joints.
+  /// \param[in] arm The arm's joint table.
+  /// \param[in] i Index into `joints`.
+  /// \param[in] sub Coordinate or chamber within the joint.
+  /// \return The unit's index in the layout.
   int unit(const std::vector<ArmJoint>& arm, std::size_t i, int sub = 0) const {
     switch (scope) {
       case Scope::Shared: return 0;
@@ -103,8 +116,14 @@ struct EffectBase {
     return 0;
   }
 
-  /// Parameter `kind` of the unit of listed joint i (see unit()), for an effect with
+  /// \brief Parameter `kind` of the unit of listed joint i (see unit()), for an effect with
   /// `num_kinds` kinds. Effect<E>::value supplies num_kinds.
+  /// \param[in] arm The arm's joint table.
+  /// \param[in] i Index into `joints`.
+  /// \param[in] kind Index of the parameter kind.
+  /// \param[in] sub Coordinate or chamber within the joint.
+  /// \param[in] num_kinds The effect's number of parameter kinds.
+  /// \return The parameter's value.
   double value_of(const std::vector<ArmJoint>& arm, std::size_t i, int kind, int sub,
                   int num_kinds) const {
     return params(static_cast<Eigen::Index>(unit(arm, i, sub)) * num_kinds + kind);
@@ -114,7 +133,8 @@ struct EffectBase {
   // xs is the effect's own slice of the effect states; q, qd the coordinates and rates;
   // p the pressures (effective ones in add_forces, recorded ones in state_derivative).
 
-  /// Extra states of the effect (e.g. the lagged pressures).
+  /// \brief Extra states of the effect (e.g. the lagged pressures).
+  /// \return How many (0 here).
   int num_states(const std::vector<ArmJoint>&) const { return 0; }
   /// True for effects whose effective_pressures replace p (actuator_lag): ArmDynamics applies
   /// them before the ones that transform p (chamber_gain), so the list order does not matter.
@@ -137,11 +157,13 @@ struct EffectBase {
   /// Measurement model: the sensors report y = gain .* q + offset; an effect multiplies
   /// `gain` and adds to `offset` (both of size nq).
   void measurement(const std::vector<ArmJoint>&, Eigen::VectorXd&, Eigen::VectorXd&) const {}
-  /// Point mass added at the tip of the chain (kg).
+  /// \brief Point mass added at the tip of the chain.
+  /// \return kg (0 here).
   double tip_mass() const { return 0; }
   /// Multiplies the masses and inertias of the chain's segments (one factor per segment).
   void mass_scale(const std::vector<ArmJoint>&, std::vector<double>&) const {}
-  /// Transport delay of the recorded pressures (s).
+  /// \brief Transport delay of the recorded pressures.
+  /// \return s (0 here).
   double input_delay() const { return 0; }
 
  private:
@@ -155,6 +177,11 @@ template <class E>
 struct Effect : EffectBase {
   /// Parameter `kind` (index into E::param_info) of listed joint i; `sub` = coordinate or
   /// chamber within the joint for PerCoordinate / PerChamber scopes.
+  /// \param[in] arm The arm's joint table.
+  /// \param[in] i Index into `joints`.
+  /// \param[in] kind Index into E::param_info.
+  /// \param[in] sub Coordinate or chamber within the joint.
+  /// \return The parameter's value.
   double value(const std::vector<ArmJoint>& arm, std::size_t i, int kind = 0,
                int sub = 0) const {
     return value_of(arm, i, kind, sub, static_cast<int>(E::param_info.size()));

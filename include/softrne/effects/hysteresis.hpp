@@ -26,12 +26,18 @@ namespace softrne {
 /// F_max = 0 the law's limit is F = 0, so dF/dt = 0 from F(0) = 0 (no division by zero) and
 /// no force acts. F starts at 0 (no memory before the record).
 struct Hysteresis : Effect<Hysteresis> {
+  /// The effect's name in robot files, reports and `--effects`.
   static constexpr const char* name = "hysteresis";
+  /// Its parameter kinds: name, plausible range, log scale, neutral value, unit.
   static constexpr std::array<ParamInfo, 2> param_info{
       {{"Fmax", 0.0, 5.0, false, 0.0, "N m"}, {"sigma", 1.0, 1e4, true, 100.0, "N m/rad"}}};
+  /// The scopes it may have (the closed loop tries each).
   static constexpr std::array<Scope, 3> scopes{Scope::Shared, Scope::PerJoint,
                                                Scope::PerCoordinate};
+  /// \brief Which joints it can act on.
+  /// \return True: every joint.
   static bool applies_to(const ArmJoint&) { return true; }
+  /// epsilon, rad/s: the smoothing speed of |qdot| (see above).
   static constexpr double kSmoothingSpeed = 1e-4;
   /// As sigma grows, F reaches +-Fmax within a vanishing angle after each reversal: the
   /// element becomes Coulomb friction with Fc = Fmax (kind 0 of both). Data from Coulomb
@@ -40,11 +46,18 @@ struct Hysteresis : Effect<Hysteresis> {
   /// its parameter (effect_reduces_to).
   static constexpr const char* reduces_to = "coulomb_friction";
 
+  /// \brief Its states (the hook of EffectBase).
+  /// \param[in] arm The arm's joint table.
+  /// \return How many states it has on this arm.
   int num_states(const std::vector<ArmJoint>& arm) const {
     int n = 0;
     for (int j : joints) n += arm[static_cast<std::size_t>(j)].nq;
     return n;
   }
+  /// \brief Adds its generalised forces to tau (the hook of EffectBase; eq. 23's right-hand side).
+  /// \param[in] arm The arm's joint table.
+  /// \param[in] F Its own states (the elements' forces, N m).
+  /// \param[in,out] tau The generalised forces, N m (rad coordinates); it adds to them.
   template <class S, class Q, class Qd, class P, class X, class Tau>
   void add_forces(const std::vector<ArmJoint>& arm, const Q&, const Qd&, const P&, const X& F,
                   Tau& tau) const {
@@ -54,6 +67,11 @@ struct Hysteresis : Effect<Hysteresis> {
       for (int k = 0; k < j.nq; ++k, ++s) tau(j.q_offset + k) -= F(s);
     }
   }
+  /// \brief Time derivative of its states (the hook of EffectBase).
+  /// \param[in] arm The arm's joint table.
+  /// \param[in] F Its own states (the elements' forces, N m).
+  /// \param[in] qd Their rates, rad/s.
+  /// \param[out] Fd The states' time derivatives.
   template <class S, class X, class Q, class Qd, class P, class Xd>
   void state_derivative(const std::vector<ArmJoint>& arm, const X& F, const Q&, const Qd& qd,
                         const P&, Xd& Fd) const {
@@ -73,6 +91,9 @@ struct Hysteresis : Effect<Hysteresis> {
       }
     }
   }
+  /// \brief Its states at the first sample (the hook of EffectBase).
+  /// \param[in] arm The arm's joint table.
+  /// \param[out] F Its own states, set here.
   template <class Q, class P, class X>
   void initial_states(const std::vector<ArmJoint>& arm, const Q&, const P&, X& F) const {
     for (int s = 0; s < num_states(arm); ++s) F(s) = 0;
