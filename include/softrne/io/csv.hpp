@@ -36,7 +36,7 @@ inline constexpr std::size_t kMaxLineLength = std::size_t{1} << 20;
 
 /// \brief A numeric CSV table: every cell of every column is a finite number.
 struct Table {
-  std::vector<std::string> header;
+  std::vector<std::string> header;  ///< the column names, in file order
   Eigen::MatrixXd values;  ///< rows x cols, columns in header order
   std::string source;      ///< the file, for messages
 };
@@ -46,13 +46,16 @@ struct Dataset {
   Eigen::VectorXd t;          ///< N, strictly increasing (s)
   Eigen::MatrixXd pressures;  ///< N x P, columns in robot order p1_0..p1_{K-1}, p2_0.. (Pa)
   Eigen::MatrixXd angles;     ///< N x nq in chain coordinate order (rad); N x 0 if absent
-  bool has_angles = false;
+  bool has_angles = false;  ///< the file has the angle columns (all of them)
   std::vector<std::string> pressure_names;  ///< the P pressure column names, in order
   std::vector<std::string> angle_names;     ///< the nq coordinate names (even when absent)
-  std::string source;
+  std::string source;  ///< the file, for messages
 };
 
 /// \brief Index of column `name` in `table.header`, or -1.
+/// \param[in] table A table.
+/// \param[in] name A column name.
+/// \return The column's index, or -1 if the table has none of that name.
 inline Eigen::Index find_column(const Table& table, const std::string& name) {
   const auto it = std::find(table.header.begin(), table.header.end(), name);
   return it == table.header.end() ? -1 : static_cast<Eigen::Index>(it - table.header.begin());
@@ -269,6 +272,11 @@ inline void check_column_name(const std::string& name) {
 }  // namespace detail
 
 /// \brief Parse a CSV text into a table (all columns must be numeric).
+/// \param[in] text The file's content.
+/// \param[in] source The file's name, for messages.
+/// \return The table.
+/// \throws InputError (Empty, BadRowLength, BadNumber, NonFinite, DuplicateColumn,
+///   LineTooLong, ...) naming source, line and column.
 inline Table parse_csv(const std::string& text, const std::string& source) {
   detail::CsvScanner scan(text, source);
   std::vector<std::size_t> wanted(scan.header().size());
@@ -285,6 +293,9 @@ inline Table parse_csv(const std::string& text, const std::string& source) {
 }
 
 /// \brief Read a CSV file into a table (all columns must be numeric).
+/// \param[in] path The file.
+/// \return The table.
+/// \throws InputError (FileNotFound, ReadFailed, or as parse_csv()).
 inline Table read_csv(const std::string& path) {
   return parse_csv(detail::read_text_file(path), path);
 }
@@ -294,6 +305,13 @@ inline Table read_csv(const std::string& path) {
 /// `require_angles`). Other columns are ignored (not even parsed), except
 /// `p{j}_{k}`, `u{j}`, `v{j}` columns the robot does not have, which mean robot
 /// and data disagree (UnexpectedColumn). `t` must increase strictly; 2 rows at least.
+/// \param[in] text The file's content.
+/// \param[in] source The file's name, for messages.
+/// \param[in] robot The robot the data belong to (its pressure and angle columns).
+/// \param[in] require_angles The angle columns must be present.
+/// \return Times, pressures and (if present) angles, in the robot's column order.
+/// \throws InputError (MissingColumn, UnexpectedColumn, NonIncreasingTime, TooFewRows, or
+///   as parse_csv()) naming source, line and column.
 inline Dataset parse_dataset(const std::string& text, const std::string& source,
                              const RobotSpec& robot, bool require_angles) {
   detail::CsvScanner scan(text, source);
@@ -396,12 +414,22 @@ inline Dataset parse_dataset(const std::string& text, const std::string& source,
 }
 
 /// \brief Read a data set for `robot` from a CSV file (see parse_dataset).
+/// \param[in] path The file.
+/// \param[in] robot The robot the data belong to.
+/// \param[in] require_angles The angle columns must be present.
+/// \return Times, pressures and (if present) angles.
+/// \throws InputError (FileNotFound, ReadFailed, or as parse_dataset()).
 inline Dataset read_dataset(const std::string& path, const RobotSpec& robot, bool require_angles) {
   return parse_dataset(detail::read_text_file(path), path, robot, require_angles);
 }
 
 /// \brief The CSV text of a table, preceded by `# ` comment lines; numbers in
 /// shortest round-trip form (reading back gives bit-identical doubles).
+/// \param[in] header The column names (one per column of values).
+/// \param[in] values The table, rows x columns.
+/// \param[in] comments Lines written first, each as `# line`.
+/// \return The CSV text.
+/// \throws std::invalid_argument if header and values disagree on the number of columns.
 inline std::string format_csv(const std::vector<std::string>& header, const Eigen::MatrixXd& values,
                               const std::vector<std::string>& comments = {}) {
   if (static_cast<Eigen::Index>(header.size()) != values.cols())
@@ -429,6 +457,10 @@ inline std::string format_csv(const std::vector<std::string>& header, const Eige
 }
 
 /// \brief Write a table as CSV (see format_csv); InputError (WriteFailed) on failure.
+/// \param[in] path The output file (written to a temporary file, then renamed).
+/// \param[in] table The table.
+/// \param[in] comments Lines written first, each as `# line`.
+/// \throws InputError (WriteFailed) if the file cannot be written.
 inline void write_csv(const std::string& path, const Table& table,
                       const std::vector<std::string>& comments = {}) {
   detail::write_text_file(path, format_csv(table.header, table.values, comments));
@@ -436,6 +468,12 @@ inline void write_csv(const std::string& path, const Table& table,
 
 /// \brief Write a trajectory `t,<names...>` (formats.md section 3) with full
 /// precision (shortest round-trip). `q` is N x names.size(), `t` has N entries.
+/// \param[in] path The output file.
+/// \param[in] t The N sample times, s.
+/// \param[in] q The N x names.size() samples.
+/// \param[in] names The column names after `t`.
+/// \throws std::invalid_argument if q and t disagree on N.
+/// \throws InputError (WriteFailed) if the file cannot be written.
 inline void write_trajectory_csv(const std::string& path, const Eigen::VectorXd& t,
                                  const Eigen::MatrixXd& q, const std::vector<std::string>& names) {
   if (q.rows() != t.size())

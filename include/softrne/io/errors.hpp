@@ -49,6 +49,8 @@ enum class Category {
 };
 
 /// \brief Name of a category, e.g. "MissingField".
+/// \param[in] c A category.
+/// \return Its name (the enumerator's).
 inline const char* to_string(Category c) noexcept {
   switch (c) {
     case Category::FileNotFound:
@@ -155,6 +157,7 @@ inline std::string format_double(double v) {
 /// `train.csv: line 17, column 'u2': not a number: 'abc'`.
 class InputError : public std::runtime_error {
  public:
+  /// \brief The error; what() is `source: where: detail` on one line.
   /// \param category what kind of problem
   /// \param source the file (as the user named it)
   /// \param where location inside the file ("" if none): field path or line/column
@@ -166,13 +169,13 @@ class InputError : public std::runtime_error {
         where_(std::move(where)),
         detail_(std::move(detail)) {}
 
-  /// \brief What kind of problem.
+  /// \return What kind of problem.
   Category category() const noexcept { return category_; }
-  /// \brief The file, as given by the user.
+  /// \return The file, as given by the user.
   const std::string& source() const noexcept { return source_; }
-  /// \brief Location inside the file (may be empty).
+  /// \return Location inside the file (may be empty).
   const std::string& where() const noexcept { return where_; }
-  /// \brief The description without file and location.
+  /// \return The description without file and location.
   const std::string& detail() const noexcept { return detail_; }
 
  private:

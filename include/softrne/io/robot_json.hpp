@@ -494,7 +494,11 @@ Json to_json_impl(const RobotSpec& robot) {
 }  // namespace detail
 
 /// \brief Build a RobotSpec from parsed JSON (e.g. a report's `fitted_robot`).
-/// \param source file name for messages; \param prefix location prefix such as "fitted_robot."
+/// \param[in] j The parsed `softrne-robot/1` object.
+/// \param[in] source File name for messages.
+/// \param[in] prefix Location prefix such as "fitted_robot." (a robot inside a report).
+/// \return The validated robot.
+/// \throws InputError naming source, the field and what is wrong (formats.md section 1).
 inline RobotSpec robot_from_json(const nlohmann::json& j, const std::string& source,
                                  const std::string& prefix = "") {
   const std::string top =
@@ -542,21 +546,33 @@ inline RobotSpec robot_from_json(const nlohmann::json& j, const std::string& sou
 }
 
 /// \brief Parse the text of a `robot.json`; `source_name` names it in messages.
+/// \param[in] text The file's content.
+/// \param[in] source_name The file's name, for messages.
+/// \return The validated robot.
+/// \throws InputError (Syntax, MissingField, UnknownField, OutOfRange, ...) naming the file,
+///   the field and what is wrong.
 inline RobotSpec parse_robot_json(const std::string& text, const std::string& source_name) {
   return robot_from_json(detail::parse_json_strict(text, source_name), source_name);
 }
 
 /// \brief Read and validate a `robot.json` file.
+/// \param[in] path The file.
+/// \return The validated robot (build a chain of it with softrne::build_arm).
+/// \throws InputError (FileNotFound, ReadFailed, or as parse_robot_json()).
 inline RobotSpec read_robot_json(const std::string& path) {
   return parse_robot_json(detail::read_text_file(path), path);
 }
 
 /// \brief The `softrne-robot/1` JSON of a robot (keys sorted, as nlohmann::json does).
+/// \param[in] robot A robot.
+/// \return Its JSON.
 inline nlohmann::json to_json(const RobotSpec& robot) {
   return detail::to_json_impl<nlohmann::json>(robot);
 }
 
 /// \brief The `softrne-robot/1` JSON of a robot with keys in the documented order.
+/// \param[in] robot A robot.
+/// \return Its JSON, keys in the order of formats.md.
 inline nlohmann::ordered_json to_ordered_json(const RobotSpec& robot) {
   return detail::to_json_impl<nlohmann::ordered_json>(robot);
 }
@@ -565,6 +581,9 @@ inline nlohmann::ordered_json to_ordered_json(const RobotSpec& robot) {
 /// in the documented order, doubles in shortest round-trip form: reading the file
 /// back gives bit-identical numbers). Throws InputError (WriteFailed, or the
 /// validation error, with source "<path> (writing)").
+/// \param[in] robot The robot.
+/// \param[in] path The output file.
+/// \throws InputError if robot breaks a rule or the file cannot be written.
 inline void write_robot_json(const RobotSpec& robot, const std::string& path) {
   const std::string src = path + " (writing)";
   for (std::size_t i = 0; i < robot.segments.size(); ++i)

@@ -17,7 +17,7 @@ namespace softrne::io {
 
 /// \brief A constant-curvature pneumatic continuum joint (two coordinates u, v).
 struct CCJointSpec {
-  std::string name;
+  std::string name;  ///< unique among the segments
   double mass = 0.0;                                    ///< kg, spread uniformly along the arc
   double height = 0.0;                                  ///< m, arc length
   double diameter = 0.0;                                ///< m, of the thin disks
@@ -36,7 +36,7 @@ struct CCJointSpec {
 
 /// \brief A rigid body fixed to the previous segment's distal frame.
 struct RigidLinkSpec {
-  std::string name;
+  std::string name;  ///< unique among the segments
   double mass = 0.0;    ///< kg
   double length = 0.0;  ///< m, the distal frame is translated by [0, 0, length]
   Eigen::Vector3d com = Eigen::Vector3d::Zero();          ///< m, in the base frame of the link
@@ -45,8 +45,8 @@ struct RigidLinkSpec {
 
 /// \brief A massless revolute joint about a unit `axis` of its base frame.
 struct RevoluteJointSpec {
-  std::string name;
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  std::string name;  ///< unique among the segments
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< unit, in its base frame
   double stiffness = 0.0;  ///< N m/rad
   double damping = 0.0;    ///< N m s/rad
 };
@@ -56,7 +56,7 @@ using SegmentSpec = std::variant<CCJointSpec, RigidLinkSpec, RevoluteJointSpec>;
 
 /// \brief An effect that a fit added to the declared model (formats.md section 4).
 struct EffectSpec {
-  std::string name;
+  std::string name;  ///< the effect's name (softrne::effect_names())
   std::vector<std::string> joints;  ///< names of segments it applies to
   /// By name: `<kind>` (shared) or `<kind>.<joint, coordinate or pressure channel>`; the
   /// names present set the scope (formats.md section 4, read by softrne::build_arm).
@@ -66,15 +66,18 @@ struct EffectSpec {
 
 /// \brief A whole robot: `robot.json`.
 struct RobotSpec {
-  std::string name;
+  std::string name;  ///< the robot's name
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< m/s^2, in the base frame
-  std::vector<SegmentSpec> segments;
-  std::vector<EffectSpec> effects;
+  std::vector<SegmentSpec> segments;  ///< base to tip
+  std::vector<EffectSpec> effects;    ///< effects added by a fit (empty when declared)
   std::string source;  ///< the file it was read from, for messages
 };
 
 /// \brief Paper eq. 24: \f$\tau_u = dA(p_0 - p_1)\f$, \f$\tau_v = dA(p_2 - p_3)\f$,
 /// \f$A = \pi r^2\f$, as a 2 x 4 matrix.
+/// \param[in] chamber_distance d, from the joint's axis to a chamber's centre, m.
+/// \param[in] chamber_radius r, a chamber's radius, m.
+/// \return K_prs, m^3 (N m per Pa).
 inline Eigen::Matrix<double, 2, Eigen::Dynamic> default_pressure_to_torque(double chamber_distance,
                                                                            double chamber_radius) {
   const double pi = 3.14159265358979323846;
@@ -86,6 +89,15 @@ inline Eigen::Matrix<double, 2, Eigen::Dynamic> default_pressure_to_torque(doubl
 }
 
 /// \brief A cc joint with the eq. 24 pressure map filled in.
+/// \param[in] name Its name.
+/// \param[in] mass kg.
+/// \param[in] height Arc length, m.
+/// \param[in] diameter Of the thin disks, m.
+/// \param[in] chamber_distance d of eq. 24, m.
+/// \param[in] chamber_radius r of eq. 24, m.
+/// \param[in] stiffness Diagonal of K_spring, N m/rad.
+/// \param[in] damping Diagonal of K_d, N m s/rad.
+/// \return The joint's description.
 inline CCJointSpec make_cc_joint(std::string name, double mass, double height, double diameter,
                                  double chamber_distance, double chamber_radius,
                                  const Eigen::Vector2d& stiffness, const Eigen::Vector2d& damping) {
@@ -105,6 +117,13 @@ inline CCJointSpec make_cc_joint(std::string name, double mass, double height, d
 /// \brief Inertia matrix from `[ixx, iyy, izz, ixy, ixz, iyz]` (the matrix
 /// entries, as in URDF: \f$I = [[i_{xx}, i_{xy}, i_{xz}], [i_{xy}, i_{yy}, i_{yz}], [i_{xz},
 /// i_{yz}, i_{zz}]]\f$).
+/// \param[in] ixx Entry (0, 0), kg m^2.
+/// \param[in] iyy Entry (1, 1).
+/// \param[in] izz Entry (2, 2).
+/// \param[in] ixy Entries (0, 1) and (1, 0).
+/// \param[in] ixz Entries (0, 2) and (2, 0).
+/// \param[in] iyz Entries (1, 2) and (2, 1).
+/// \return The symmetric matrix.
 inline Eigen::Matrix3d inertia_from_array(double ixx, double iyy, double izz, double ixy,
                                           double ixz, double iyz) {
   Eigen::Matrix3d I;
@@ -115,6 +134,8 @@ inline Eigen::Matrix3d inertia_from_array(double ixx, double iyy, double izz, do
 }
 
 /// \brief `[ixx, iyy, izz, ixy, ixz, iyz]` of an inertia matrix (the upper triangle).
+/// \param[in] I An inertia matrix.
+/// \return Its six entries, in the order of inertia_from_array().
 inline Eigen::Matrix<double, 6, 1> inertia_to_array(const Eigen::Matrix3d& I) {
   Eigen::Matrix<double, 6, 1> a;
   a << I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2);
@@ -122,6 +143,8 @@ inline Eigen::Matrix<double, 6, 1> inertia_to_array(const Eigen::Matrix3d& I) {
 }
 
 /// \brief "cc_joint", "rigid_link" or "revolute_joint".
+/// \param[in] s A segment.
+/// \return Its `type` in robot files.
 inline const char* segment_type(const SegmentSpec& s) {
   switch (s.index()) {
     case 0:
@@ -134,11 +157,15 @@ inline const char* segment_type(const SegmentSpec& s) {
 }
 
 /// \brief The segment's name.
+/// \param[in] s A segment.
+/// \return Its name.
 inline const std::string& segment_name(const SegmentSpec& s) {
   return std::visit([](const auto& x) -> const std::string& { return x.name; }, s);
 }
 
 /// \brief Number of coordinates of a segment: 2, 0 or 1.
+/// \param[in] s A segment.
+/// \return 2 (cc joint), 0 (rigid link) or 1 (revolute joint).
 inline int segment_nq(const SegmentSpec& s) {
   switch (s.index()) {
     case 0:
@@ -151,6 +178,8 @@ inline int segment_nq(const SegmentSpec& s) {
 }
 
 /// \brief Number of cc joints.
+/// \param[in] r A robot.
+/// \return How many of its segments are cc joints.
 inline std::size_t num_cc_joints(const RobotSpec& r) {
   std::size_t n = 0;
   for (const auto& s : r.segments) n += std::holds_alternative<CCJointSpec>(s) ? 1u : 0u;
@@ -158,6 +187,8 @@ inline std::size_t num_cc_joints(const RobotSpec& r) {
 }
 
 /// \brief Number of coordinates (2 per cc joint, 1 per revolute joint).
+/// \param[in] r A robot.
+/// \return nq.
 inline std::size_t num_coordinates(const RobotSpec& r) {
   std::size_t n = 0;
   for (const auto& s : r.segments) n += static_cast<std::size_t>(segment_nq(s));
@@ -165,6 +196,8 @@ inline std::size_t num_coordinates(const RobotSpec& r) {
 }
 
 /// \brief Total number of pressure columns (sum of the chambers of the cc joints).
+/// \param[in] r A robot.
+/// \return The number of pressure inputs.
 inline std::size_t num_pressure_columns(const RobotSpec& r) {
   std::size_t n = 0;
   for (const auto& s : r.segments)
@@ -175,6 +208,8 @@ inline std::size_t num_pressure_columns(const RobotSpec& r) {
 
 /// \brief Coordinate (angle column) names in chain order: `u{j}`, `v{j}` for the
 /// j-th cc joint (1-based among cc joints), `q{name}` for a revolute joint.
+/// \param[in] r A robot.
+/// \return nq names.
 inline std::vector<std::string> coordinate_names(const RobotSpec& r) {
   std::vector<std::string> names;
   std::size_t j = 0;
@@ -192,6 +227,8 @@ inline std::vector<std::string> coordinate_names(const RobotSpec& r) {
 
 /// \brief Pressure column names in robot order: `p{j}_{k}`, j = 1.. over cc
 /// joints, k = 0..K_j-1.
+/// \param[in] r A robot.
+/// \return One name per pressure input.
 inline std::vector<std::string> pressure_column_names(const RobotSpec& r) {
   std::vector<std::string> names;
   std::size_t j = 0;

@@ -217,6 +217,8 @@ inline void validate_robot_global(const RobotSpec& robot, const std::string& sou
 
 /// \brief Check every rule of `softrne-robot/1` on a spec (built in code or read);
 /// throws InputError naming `robot.source`, the segment and the field.
+/// \param[in] robot The robot to check.
+/// \throws InputError for the first rule it breaks.
 inline void validate_robot(const RobotSpec& robot) {
   for (std::size_t i = 0; i < robot.segments.size(); ++i)
     detail::validate_segment(robot.segments[i], i, robot.source);
