@@ -40,13 +40,13 @@ struct ArmSimulationOptions {
   CvodeOptions cvode = default_cvode();
   /// How recorded pressures are read between samples (see PressureInterpolation).
   enum class PressureInterpolation { pchip, linear, zero_order_hold };
-  PressureInterpolation interpolation = PressureInterpolation::pchip;
+  PressureInterpolation interpolation = PressureInterpolation::pchip;  ///< PCHIP by default
   /// Jacobian of the state equation by forward-mode AutoDiff through the templated RNE
   /// (exact); false: CVODE's internal finite differences.
   bool autodiff_jacobian = true;
   /// How the AutoDiff Jacobian is formed (both exact; see ArmSystem::JacobianMethod).
   enum class JacobianMethod { inverse_dynamics, forward_dynamics };
-  JacobianMethod jacobian_method = JacobianMethod::inverse_dynamics;
+  JacobianMethod jacobian_method = JacobianMethod::inverse_dynamics;  ///< the cheaper one
   /// Absolute tolerance of the velocities = cvode.atol * velocity_atol_factor (1/s): a
   /// velocity error dv moves the angles by about dv / omega for a mode of frequency omega.
   /// 1 gives every state the same atol.
@@ -61,6 +61,7 @@ struct ArmSimulationOptions {
   /// for progress indicators. Empty: never.
   std::function<void(double t)> progress;
 
+  /// \return CvodeOptions with rtol 1e-6 and atol 1e-4 (the defaults of `cvode`).
   static CvodeOptions default_cvode() {
     CvodeOptions c;
     c.rtol = 1e-6;
@@ -74,13 +75,17 @@ struct ArmSimulationOptions {
 struct ArmSimulation {
   Eigen::MatrixXd angles;  ///< N x nq (rows computed before a failure, if any)
   Eigen::MatrixXd states;  ///< N x num_states
-  SimulationResult result;
+  SimulationResult result;  ///< success, message and solver statistics
+  /// \return True if the integration reached the end of the grid.
   bool ok() const { return result.ok; }
 };
 
 /// \brief Times where the recorded pressures jump (a pressure step): the integrator restarts
 /// there. A jump is a sample-to-sample change larger than both 10x the channel's median change
 /// (noise) and 5% of its range; relative, so it does not depend on units or the robot.
+/// \param[in] t The N sample times, s.
+/// \param[in] p N x P recorded pressures.
+/// \return The sample times where a step starts, increasing.
 inline std::vector<double> pressure_jumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& p) {
   std::vector<double> out;
   const Eigen::Index n = t.size();
@@ -110,6 +115,10 @@ inline std::vector<double> pressure_jumps(const Eigen::VectorXd& t, const Eigen:
 /// they reach zero (so that rounding in the window bounds cannot matter), renormalised at the
 /// ends. Works on irregular grids; non-negative weights, so no overshoot at pressure steps.
 /// sigma <= 0 returns the input. Cost O(N * window).
+/// \param[in] t The N sample times, s (irregular allowed).
+/// \param[in] p N x P samples.
+/// \param[in] sigma The kernel's standard deviation, s.
+/// \return The smoothed N x P samples.
 inline Eigen::MatrixXd smooth_pressures(const Eigen::VectorXd& t, const Eigen::MatrixXd& p,
                                         double sigma) {
   if (!(sigma > 0) || t.size() < 2) return p;
@@ -140,8 +149,8 @@ class ArmSystem {
   /// Derivative directions per AutoDiff pass. 2 (one SSE register) measured fastest for the
   /// 12-state bundled arm: 0.43M instructions per Jacobian against 0.67M with 4, 0.73M with 12.
   static constexpr int kBlock = 2;
-  using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, kBlock, 1>>;
-  using ADVector = Eigen::Matrix<AD, Eigen::Dynamic, 1>;
+  using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, kBlock, 1>>;  ///< kBlock directions
+  using ADVector = Eigen::Matrix<AD, Eigen::Dynamic, 1>;  ///< a state of AD scalars
 
   /// \brief How jacobian() differentiates the acceleration rows; both are exact (AutoDiff).
   /// - inverse_dynamics: \f$\partial\ddot q/\partial x = M^{-1}(\partial\tau/\partial x -
@@ -154,25 +163,37 @@ class ArmSystem {
   ///   passes, Cholesky).
   using JacobianMethod = ArmSimulationOptions::JacobianMethod;
 
-  /// \param t, pressures the recorded samples (N, N x num_inputs)
+  /// \brief The system of `desc` driven by the recorded pressures.
+  /// \param desc the arm; it must outlive the system
+  /// \param t the N sample times
+  /// \param pressures the recorded samples, N x num_inputs
   /// \param mode PCHIP (C1, no overshoot), linear, or zero-order hold between samples
   ArmSystem(const ArmDescription& desc, const Eigen::VectorXd& t, const Eigen::MatrixXd& pressures,
             ArmSimulationOptions::PressureInterpolation mode);
 
+  /// \return The number of states (2 nq + the effects' states).
   int size() const { return desc_.num_states(); }
+  /// \return The arm it simulates.
   const ArmDescription& description() const { return desc_; }
 
-  /// Progress callback (see ArmSimulationOptions::progress); must outlive the system.
+  /// \brief Progress callback (see ArmSimulationOptions::progress); must outlive the system.
+  /// \param[in] f The callback, or nullptr (or an empty function) for none.
   void set_progress(const std::function<void(double)>* f) { progress_ = f && *f ? f : nullptr; }
+  /// \brief Chooses how jacobian() differentiates.
+  /// \param[in] m The method.
   void set_jacobian_method(JacobianMethod m) { method_ = m; }
+  /// \return How jacobian() differentiates.
   JacobianMethod jacobian_method() const { return method_; }
 
-  /// Called by integrate() before each segment between breakpoints: a zero-order-hold input
-  /// gives at the segment's end the value held before the jump there (see cvode.hpp).
+  /// \brief Called by integrate() before each segment between breakpoints: a zero-order-hold
+  /// input gives at the segment's end the value held before the jump there (see cvode.hpp).
+  /// \param[in] t_end The segment's end time, s.
   void set_segment(std::size_t, double, double t_end) { segment_end_ = t_end; }
 
   /// Recorded pressures that act at time t: read at t - input_delay (input_delay effect),
   /// clamped to the first sample before it (the signals clamp outside their range).
+  /// \param[in] t Time, s.
+  /// \return The num_inputs pressures, Pa (valid until the next call).
   const Eigen::VectorXd& pressures(double t) {
     const double tr = t - delay_;
     if (mode_ == ArmSimulationOptions::PressureInterpolation::pchip)
@@ -182,13 +203,21 @@ class ArmSystem {
     return p_;
   }
 
-  /// The transport delay the system applies to the recorded pressures (s).
+  /// \return The transport delay the system applies to the recorded pressures, s.
   double input_delay() const { return delay_; }
 
-  /// x' = f(t, x) (eq. 23 with the effects); false if it is not finite.
+  /// \brief x' = f(t, x) (eq. 23 with the effects).
+  /// \param[in] t Time, s.
+  /// \param[in] x The state (q, qdot, effect states).
+  /// \param[out] xdot Its time derivative.
+  /// \return False if xdot is not finite.
   bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> xdot);
 
-  /// The exact Jacobian df/dx by AutoDiff (JacobianMethod); false if it is not finite.
+  /// \brief The exact Jacobian df/dx by AutoDiff (JacobianMethod).
+  /// \param[in] t Time, s.
+  /// \param[in] x The state.
+  /// \param[out] J df/dx, size() x size().
+  /// \return False if J is not finite.
   bool jacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
                 const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J);
 
@@ -366,6 +395,17 @@ class ScaledSystem {
 
 /// \brief Simulates the arm on the time grid t with the recorded pressures (N x num_inputs),
 /// from rest at the measured configuration q0 (size nq; zero if empty).
+///
+/// The state equation is eq. 23 with the effects (ArmDynamics), integrated by CVODE's BDF
+/// method with the exact AutoDiff Jacobian; the integration restarts at pressure steps
+/// (pressure_jumps()).
+/// \param[in] desc The arm (chain, springs, dampers, pressure maps, effects): build_arm().
+/// \param[in] t The N output (and input sample) times, s.
+/// \param[in] pressures N x num_inputs recorded pressures, Pa.
+/// \param[in] q0 The measured angles at t(0) (size nq), or empty for zero.
+/// \param[in] opt Integrator, interpolation and Jacobian settings.
+/// \return The measured-space angles and states on the grid; result.ok false with a one-line
+///   result.message if the integration failed (no exception for a computation that fails).
 SOFTRNE_SIM_INLINE ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::VectorXd& t,
                                               const Eigen::MatrixXd& pressures, const Eigen::VectorXd& q0,
                                               const ArmSimulationOptions& opt = {})

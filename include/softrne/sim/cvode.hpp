@@ -91,14 +91,14 @@ struct SimulationStats {
 
 /// \brief Output of integrate().
 struct SimulationResult {
-  bool ok = false;
+  bool ok = false;  ///< the integration reached the last output time
   /// "" when ok; else one line: the reason and the time reached, e.g.
   /// "CVODE failed at t = 3.217 s: too many steps (100000)".
   std::string message;
   double t_reached = 0;  ///< last time the solution is known at
   /// One row per output time reached (all of them when ok), one column per state.
   Eigen::MatrixXd x;
-  SimulationStats stats;
+  SimulationStats stats;  ///< solver statistics (steps, evaluations, time)
 };
 
 namespace detail {

@@ -57,12 +57,25 @@ struct Rk4Workspace {
   static_assert(Vector::ColsAtCompileTime == 1,
                 "Rk4Workspace: Vector must be a column vector type");
   Vector k1, k2, k3, k4, x_stage;
+  /// \var k1
+  /// \brief Slope at the step's start.
+  /// \var k2
+  /// \brief First slope at the midpoint.
+  /// \var k3
+  /// \brief Second slope at the midpoint.
+  /// \var k4
+  /// \brief Slope at the step's end.
+  /// \var x_stage
+  /// \brief The state at which the next slope is evaluated.
 
   /// \brief Sizes every buffer to n (must equal the fixed size, if any).
+  /// \param[in] n The state's size.
   explicit Rk4Workspace(Eigen::Index n = Vector::SizeAtCompileTime > 0 ? Vector::SizeAtCompileTime
                                                                        : 0) {
     resize(n);
   }
+  /// \brief Sizes every buffer to n.
+  /// \param[in] n The state's size.
   void resize(Eigen::Index n) {
     k1.resize(n);
     k2.resize(n);
@@ -80,6 +93,12 @@ struct Rk4Workspace {
 /// `Vector&` (an `Eigen::Ref` or a template parameter works too), returning
 /// void or bool. When an evaluation returns false the step stops, `x` is left
 /// unchanged and false is returned.
+/// \param[in,out] sys The system (its rhs may keep state, e.g. a cursor).
+/// \param[in] t The step's start time.
+/// \param[in,out] x The state: x(t) on entry, x(t + dt) on success.
+/// \param[in] dt The step.
+/// \param[in,out] work Scratch of x's size.
+/// \return False if an evaluation of rhs returned false.
 template <class System, class Vector>
 bool rk4_step(System& sys, double t, Vector& x, double dt, Rk4Workspace<Vector>& work) {
   static_assert(detail::has_fixed_step_rhs<System, Vector>::value,
@@ -107,14 +126,17 @@ template <class Vector = Eigen::VectorXd>
 struct SemiImplicitEulerWorkspace {
   static_assert(Vector::ColsAtCompileTime == 1,
                 "SemiImplicitEulerWorkspace: Vector must be a column vector type");
-  Vector qdd;
+  Vector qdd;  ///< the acceleration at the step's start
 
   /// \brief Sizes the buffer to n (must equal the fixed size, if any).
+  /// \param[in] n The number of coordinates.
   explicit SemiImplicitEulerWorkspace(Eigen::Index n = Vector::SizeAtCompileTime > 0
                                                            ? Vector::SizeAtCompileTime
                                                            : 0) {
     resize(n);
   }
+  /// \brief Sizes the buffer to n.
+  /// \param[in] n The number of coordinates.
   void resize(Eigen::Index n) { qdd.resize(n); }
 };
 
@@ -128,6 +150,13 @@ struct SemiImplicitEulerWorkspace {
 /// provides `acceleration(t, q, qd, qdd)` callable with `const Vector&`,
 /// `const Vector&`, `Vector&`, returning void or bool; on false, `q` and `qd`
 /// are left unchanged and false is returned.
+/// \param[in,out] sys The system.
+/// \param[in] t The step's start time.
+/// \param[in,out] q The coordinates, advanced on success.
+/// \param[in,out] qd Their rates, advanced on success.
+/// \param[in] dt The step.
+/// \param[in,out] work Scratch of q's size.
+/// \return False if the acceleration returned false.
 template <class System, class Vector>
 bool semi_implicit_euler_step(System& sys, double t, Vector& q, Vector& qd, double dt,
                               SemiImplicitEulerWorkspace<Vector>& work) {

@@ -54,6 +54,11 @@ class InputSignal {
 
   /// \brief Builds the signal from sample times (size N) and values (N x P,
   /// one row per sample). Throws std::invalid_argument when an invariant fails.
+  /// \param[in] times The N sample times, s, strictly increasing.
+  /// \param[in] values N x P, one row per sample.
+  /// \param[in] interpolation Zero-order hold (default) or linear between samples.
+  /// \throws std::invalid_argument if there is no sample, the sizes disagree, a value is
+  ///   not finite or the times do not increase strictly.
   InputSignal(const Eigen::Ref<const Eigen::VectorXd>& times,
               const Eigen::Ref<const Eigen::MatrixXd>& values,
               Interpolation interpolation = Interpolation::zero_order_hold)
@@ -71,37 +76,56 @@ class InputSignal {
             "InputSignal: sample times are not strictly increasing at index " + std::to_string(i));
   }
 
-  /// \brief Number of channels P.
+  /// \return The number of channels P.
   Eigen::Index size() const { return samples_.rows(); }
-  /// \brief Number of samples N.
+  /// \return The number of samples N.
   Eigen::Index num_samples() const { return times_.size(); }
-  /// \brief First sample time.
+  /// \return The first sample time.
   double t_begin() const { return times_[0]; }
-  /// \brief Last sample time.
+  /// \return The last sample time.
   double t_end() const { return times_[times_.size() - 1]; }
-  /// \brief Sample times (N).
+  /// \return The sample times (N).
   const Eigen::VectorXd& times() const { return times_; }
   /// \brief Sample i as a contiguous column (P).
+  /// \param[in] i A sample index, 0 <= i < N.
+  /// \return A view of the sample's P values.
   auto sample(Eigen::Index i) const { return samples_.col(i); }
+  /// \return How values between samples are obtained.
   Interpolation interpolation() const { return interpolation_; }
 
   /// \brief Writes \f$u(t)\f$ into `out` (size P; a vector or a block such as
   /// `x.segment(i, P)`), using the object's cursor.
+  /// \param[in] t Time, s (clamped to the samples' range).
+  /// \param[out] out The P values at t.
+  /// \param[in] side At a jump of a zero-order hold: the value after it (right) or before.
   template <class Derived>
   void value(double t, Eigen::MatrixBase<Derived>& out, Side side = Side::right) {
     evaluate(t, out, cursor_, side);
   }
+  /// \brief As value(t, out, side) for a temporary block such as `x.segment(i, P)`.
+  /// \param[in] t Time, s.
+  /// \param[out] out The P values at t.
+  /// \param[in] side The side of a jump.
   template <class Derived>
   void value(double t, Eigen::MatrixBase<Derived>&& out, Side side = Side::right) {
     evaluate(t, out, cursor_, side);
   }
 
   /// \brief Writes \f$u(t)\f$ into `out` (size P), using the caller's cursor.
+  /// \param[in] t Time, s (clamped to the samples' range).
+  /// \param[out] out The P values at t.
+  /// \param[in,out] cursor The caller's cursor (one per thread).
+  /// \param[in] side The side of a jump.
   template <class Derived>
   void value(double t, Eigen::MatrixBase<Derived>& out, SignalCursor& cursor,
              Side side = Side::right) const {
     evaluate(t, out, cursor, side);
   }
+  /// \brief As value(t, out, cursor, side) for a temporary block.
+  /// \param[in] t Time, s.
+  /// \param[out] out The P values at t.
+  /// \param[in,out] cursor The caller's cursor.
+  /// \param[in] side The side of a jump.
   template <class Derived>
   void value(double t, Eigen::MatrixBase<Derived>&& out, SignalCursor& cursor,
              Side side = Side::right) const {
@@ -116,6 +140,8 @@ class InputSignal {
   /// zero slope of the clamped extension before \f$t_0\f$ and after \f$t_{N-1}\f$.
   /// With densely sampled data almost every sample is a breakpoint; stopping at
   /// each one costs a solver restart, so pass a tolerance or thin the list.
+  /// \param[in] tolerance Smallest jump (or slope change) that counts.
+  /// \return The breakpoint times, increasing.
   std::vector<double> breakpoints(double tolerance = 0.0) const {
     std::vector<double> result;
     const Eigen::Index n = times_.size();

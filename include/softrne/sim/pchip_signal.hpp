@@ -21,6 +21,10 @@ namespace softrne::sim {
 /// the sampled range. No allocation per query.
 class PchipSignal {
  public:
+  /// \brief The interpolant of N samples (Fritsch-Carlson slopes).
+  /// \param[in] t The N sample times, s, increasing.
+  /// \param[in] values N x P, one row per sample.
+  /// \throws std::invalid_argument if there is no sample or the sizes disagree.
   PchipSignal(const Eigen::VectorXd& t, const Eigen::MatrixXd& values) : t_(t), y_(values) {
     const Eigen::Index n = t.size();
     if (n < 1 || values.rows() != n) throw std::invalid_argument("PchipSignal: bad sizes");
@@ -40,8 +44,13 @@ class PchipSignal {
     }
   }
 
+  /// \return The number of channels P.
   Eigen::Index size() const { return y_.cols(); }
 
+  /// \brief The interpolated values at t (clamped outside the samples); moves the cursor,
+  /// so one object serves one thread.
+  /// \param[in] t Time, s.
+  /// \param[out] out The P values (a row or column vector).
   template <class Out>
   void value(double t, Out& out) {
     const Eigen::Index n = t_.size();
