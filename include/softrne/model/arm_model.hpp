@@ -25,28 +25,33 @@ namespace softrne {
 /// The chain itself is built for any Scalar by `make_chain<S>()`.
 struct ArmDescription {
   io::RobotSpec spec;  ///< what it was built from (segments, gravity)
-  std::vector<ArmJoint> joints;
-  std::vector<AnyEffect> effects;
-  std::vector<std::string> coordinate_names;
-  std::vector<std::string> pressure_names;
-  int nq = 0;
-  int num_inputs = 0;
-  int num_effect_states = 0;
-  std::vector<int> effect_state_offsets;
+  std::vector<ArmJoint> joints;  ///< the joints with coordinates, base to tip
+  std::vector<AnyEffect> effects;  ///< the effects added to eq. 23, in order
+  std::vector<std::string> coordinate_names;  ///< u1, v1, ..., in q's order
+  std::vector<std::string> pressure_names;    ///< p1_0, ..., in the pressure vector's order
+  int nq = 0;                 ///< number of coordinates
+  int num_inputs = 0;         ///< number of pressure inputs
+  int num_effect_states = 0;  ///< number of the effects' states
+  std::vector<int> effect_state_offsets;  ///< effect k's first state among them
   /// Consistent (Euler-Lagrange of the lumped energy) or the paper's frozen-inertia eq. 18.
   InertiaRate inertia_rate = InertiaRate::Consistent;
 
-  /// State x = [q, qdot, effect states].
+  /// \brief State x = [q, qdot, effect states].
+  /// \return Its size, 2 nq + num_effect_states.
   int num_states() const { return 2 * nq + num_effect_states; }
 
-  /// Index of the joint named `name`, or -1.
+  /// \brief Index of the joint named `name`, or -1.
+  /// \param[in] name A segment name.
+  /// \return Its index in `joints`, or -1.
   int joint_index(const std::string& name) const {
     for (std::size_t i = 0; i < joints.size(); ++i)
       if (joints[i].name == name) return static_cast<int>(i);
     return -1;
   }
 
-  /// Size of effect k's slice of the effect states.
+  /// \brief Size of effect k's slice of the effect states.
+  /// \param[in] k An index into `effects`.
+  /// \return Its number of states.
   int effect_state_size(std::size_t k) const {
     const int end = k + 1 < effect_state_offsets.size() ? effect_state_offsets[k + 1]
                                                          : num_effect_states;
@@ -55,43 +60,53 @@ struct ArmDescription {
 
   /// Measurement model: the sensors report y = gain .* q + offset (sensor_gain,
   /// angle_offset); both nq vectors, gain 1 and offset 0 without effects.
+  /// \param[out] gain The gains (nq).
+  /// \param[out] offset The offsets (nq), rad.
   void measurement(Eigen::VectorXd& gain, Eigen::VectorXd& offset) const {
     gain = Eigen::VectorXd::Ones(nq);
     offset = Eigen::VectorXd::Zero(nq);
     for (const auto& e : effects)
       std::visit([&](const auto& x) { x.measurement(joints, gain, offset); }, e);
   }
+  /// \return The measurement gains (nq); see measurement().
   Eigen::VectorXd measurement_gain() const {
     Eigen::VectorXd g, o;
     measurement(g, o);
     return g;
   }
+  /// \return The measurement offsets (nq), rad; see measurement().
   Eigen::VectorXd measurement_offset() const {
     Eigen::VectorXd g, o;
     measurement(g, o);
     return o;
   }
-  /// What the sensors report for simulated coordinates q.
+  /// \brief What the sensors report for simulated coordinates q.
+  /// \param[in] q Simulated coordinates (nq), rad.
+  /// \return gain .* q + offset.
   Eigen::VectorXd measured(const Eigen::VectorXd& q) const {
     Eigen::VectorXd g, o;
     measurement(g, o);
     return g.cwiseProduct(q) + o;
   }
-  /// The simulated coordinates that the sensors report as y: (y - offset) ./ gain.
+  /// \brief The simulated coordinates that the sensors report as y: (y - offset) ./ gain.
+  /// \param[in] y Measured angles (nq), rad.
+  /// \return The coordinates, rad.
   Eigen::VectorXd coordinates_from_measured(const Eigen::VectorXd& y) const {
     Eigen::VectorXd g, o;
     measurement(g, o);
     return (y - o).cwiseQuotient(g);
   }
 
-  /// Transport delay of the recorded pressures (s): the sum of the effects' delays.
+  /// \brief Transport delay of the recorded pressures: the sum of the effects' delays.
+  /// \return s.
   double input_delay() const {
     double d = 0;
     for (const auto& e : effects) d += std::visit([](const auto& x) { return x.input_delay(); }, e);
     return d;
   }
 
-  /// Mass of the segments of the spec (kg), without effects.
+  /// \brief Mass of the segments of the spec, without effects.
+  /// \return kg.
   double segment_mass() const {
     double m = 0;
     for (const auto& seg : spec.segments)
@@ -101,14 +116,16 @@ struct ArmDescription {
     return m;
   }
 
-  /// Point mass the effects add at the tip (payload), kg.
+  /// \brief Point mass the effects add at the tip (payload).
+  /// \return kg.
   double tip_mass() const {
     double m = 0;
     for (const auto& e : effects) m += std::visit([](const auto& x) { return x.tip_mass(); }, e);
     return m;
   }
 
-  /// Factor on each segment's mass and inertia (mass_scale); 1 without effects.
+  /// \brief Factor on each segment's mass and inertia (mass_scale); 1 without effects.
+  /// \return One factor per segment of the spec.
   std::vector<double> segment_mass_scale() const {
     std::vector<double> s(spec.segments.size(), 1.0);
     for (const auto& e : effects) std::visit([&](const auto& x) { x.mass_scale(joints, s); }, e);
@@ -117,6 +134,8 @@ struct ArmDescription {
 
   /// \brief The chain: the segments of the spec with their masses and inertias scaled by any
   /// mass_scale effect, plus a payload point mass if an effect adds one.
+  /// \tparam S The scalar type (double, or an AutoDiff type for the Jacobian).
+  /// \return The runtime chain (its springs, dampers and pressure maps are in `joints`).
   template <class S>
   DynamicChain<S> make_chain() const {
     DynamicChain<S> c;
@@ -171,12 +190,18 @@ struct ArmDescription {
 
 /// \brief Names of an effect's parameters on this arm (effect_param_names with the
 /// description's coordinate and pressure names).
+/// \param[in] e An effect.
+/// \param[in] d The arm.
+/// \return One name per entry of e's params.
 inline std::vector<std::string> effect_param_names(const AnyEffect& e, const ArmDescription& d) {
   return effect_param_names(e, d.joints, d.coordinate_names, d.pressure_names);
 }
 
 /// \brief Appends an effect to the description and gives it its slice of the effect states.
 /// Throws std::invalid_argument if its parameter count does not match its scope and joints.
+/// \param[in,out] d The arm.
+/// \param[in] e The effect, with its joints, scope and params set.
+/// \throws std::invalid_argument if e's params have the wrong size.
 SOFTRNE_SIM_INLINE void add_effect(ArmDescription& d, AnyEffect e)
 #if SOFTRNE_SIM_BODIES
 {
@@ -198,6 +223,12 @@ SOFTRNE_SIM_INLINE void add_effect(ArmDescription& d, AnyEffect e)
 /// joint table; all joints it applies to when empty) with `scope`. Throws
 /// std::invalid_argument on an unknown name, a scope the effect does not allow, or a joint it
 /// does not apply to.
+/// \param[in] name The effect's name.
+/// \param[in] d The arm.
+/// \param[in] scope Its scope.
+/// \param[in] joints Indices into d.joints; empty: every joint it applies to.
+/// \return The effect, every parameter at its neutral value.
+/// \throws std::invalid_argument as said above.
 SOFTRNE_SIM_INLINE AnyEffect make_effect_at_neutral(const std::string& name, const ArmDescription& d,
                                                     Scope scope, std::vector<int> joints = {})
 #if SOFTRNE_SIM_BODIES
@@ -314,6 +345,11 @@ SOFTRNE_SIM_INLINE void read_effect_params(const io::EffectSpec& es, const ArmDe
 
 /// \brief Builds the description from a robot spec; its `effects` become model effects.
 /// Throws std::invalid_argument naming the effect and field on an inconsistent effect.
+///
+/// The joint table carries each joint's K_spring, K_d and K_prs (eqs. 23-24).
+/// \param[in] spec A robot, e.g. from io::read_robot_json().
+/// \return The arm (chain constants, joint table, effects, sizes).
+/// \throws std::invalid_argument naming the effect and field on an inconsistent effect.
 SOFTRNE_SIM_INLINE ArmDescription build_arm(const io::RobotSpec& spec)
 #if SOFTRNE_SIM_BODIES
 {
@@ -394,6 +430,8 @@ SOFTRNE_SIM_INLINE ArmDescription build_arm(const io::RobotSpec& spec)
 #endif
 
 /// \brief The effects as robot-file entries (formats.md section 4), parameters by name.
+/// \param[in] a The arm.
+/// \return One entry per effect.
 SOFTRNE_SIM_INLINE std::vector<io::EffectSpec> effect_specs(const ArmDescription& a)
 #if SOFTRNE_SIM_BODIES
 {
@@ -415,6 +453,8 @@ SOFTRNE_SIM_INLINE std::vector<io::EffectSpec> effect_specs(const ArmDescription
 
 /// \brief The robot spec with the description's current stiffness, damping, pressure maps and
 /// effects written back (what `softrne-fit` saves).
+/// \param[in] a The arm.
+/// \return Its robot spec.
 SOFTRNE_SIM_INLINE io::RobotSpec to_robot_spec(const ArmDescription& a)
 #if SOFTRNE_SIM_BODIES
 {
@@ -445,8 +485,10 @@ SOFTRNE_SIM_INLINE io::RobotSpec to_robot_spec(const ArmDescription& a)
 template <class S>
 class ArmDynamics {
  public:
-  using VectorS = Eigen::Matrix<S, Eigen::Dynamic, 1>;
+  using VectorS = Eigen::Matrix<S, Eigen::Dynamic, 1>;  ///< a vector of the scalar type
 
+  /// \brief The state equation of `desc`, which must outlive it.
+  /// \param[in] desc The arm.
   explicit ArmDynamics(const ArmDescription& desc)
       : desc_(&desc), chain_(desc.make_chain<S>()), data_(chain_.make_data()) {
     // The payload link (if any) has no coordinates: nq of the chain equals desc.nq.
@@ -454,14 +496,20 @@ class ArmDynamics {
     tau_.resize(desc.nq);
   }
 
+  /// \return The arm.
   const ArmDescription& description() const { return *desc_; }
+  /// \return Its chain in scalar type S.
   const DynamicChain<S>& chain() const { return chain_; }
+  /// \return The chain's workspace (what the last evaluation left).
   DynamicChainData<S>& data() { return data_; }
 
   /// \brief The pressures that drive the joints: the recorded ones changed by the effects.
   /// Effects that replace them (actuator_lag) act first, then those that transform them
   /// (chamber_gain), each group in list order; so the result does not depend on the order in
   /// which a fit added them.
+  /// \param[in] xs The effect states.
+  /// \param[in] p_recorded The recorded pressures, Pa.
+  /// \param[out] p_eff The effective pressures, Pa.
   template <class X, class P>
   void effective_pressures(const X& xs, const P& p_recorded, VectorS& p_eff) const {
     const auto& d = *desc_;
@@ -477,7 +525,13 @@ class ArmDynamics {
   }
 
   /// \brief Generalised forces other than inertia and gravity: \f$K_{prs}p - Kq - K_d\dot q\f$
-  /// plus the effects, at the effective pressures p and effect states xs.
+  /// plus the effects, at the effective pressures p and effect states xs (the u of
+  /// forward_dynamics()).
+  /// \param[in] q The coordinates, rad.
+  /// \param[in] qd Their rates, rad/s.
+  /// \param[in] p The effective pressures, Pa.
+  /// \param[in] xs The effect states.
+  /// \return The generalised forces (valid until the next call).
   template <class Q, class Qd, class P, class X>
   const VectorS& joint_forces(const Q& q, const Qd& qd, const P& p, const X& xs) {
     const auto& d = *desc_;
@@ -498,6 +552,11 @@ class ArmDynamics {
 
   /// \brief Time derivative of the effect states (size num_effect_states) given the
   /// recorded pressures.
+  /// \param[in] xs The effect states.
+  /// \param[in] q The coordinates.
+  /// \param[in] qd Their rates.
+  /// \param[in] p_recorded The recorded pressures, Pa.
+  /// \param[out] xsd Their time derivatives.
   template <class X, class Q, class Qd, class P, class Xd>
   void effect_state_derivative(const X& xs, const Q& q, const Qd& qd, const P& p_recorded,
                                Xd&& xsd) const {
@@ -512,7 +571,11 @@ class ArmDynamics {
     }
   }
 
-  /// \brief x' = f(x, p_recorded).
+  /// \brief x' = f(x, p_recorded): qdot, the accelerations of eq. 23 (forward dynamics with
+  /// joint_forces()), and the effect states' derivatives.
+  /// \param[in] x The state [q, qdot, effect states].
+  /// \param[in] p_recorded The recorded pressures, Pa.
+  /// \param[out] xdot Its time derivative.
   template <class X, class P, class Xd>
   void rhs(const X& x, const P& p_recorded, Xd& xdot) {
     const auto& d = *desc_;
@@ -544,6 +607,10 @@ class ArmDynamics {
 /// \brief Initial state: at rest at the first measured configuration with the measurement
 /// model inverted (q0 = (y0 - offset) ./ gain), effect states from q0 and the first recorded
 /// pressures. An empty y0 means q0 = 0.
+/// \param[in] d The arm.
+/// \param[in] q0_measured The first measured angles y0 (nq), or empty.
+/// \param[in] p0 The first recorded pressures, Pa.
+/// \return The state [q0, 0, effect states].
 SOFTRNE_SIM_INLINE Eigen::VectorXd initial_state(const ArmDescription& d, const Eigen::VectorXd& q0_measured,
                                                  const Eigen::VectorXd& p0)
 #if SOFTRNE_SIM_BODIES

@@ -14,13 +14,19 @@ namespace softrne {
 /// \brief Mean, median and max of |simulated - measured| for one angle or all of them.
 struct ErrorSummary {
   double mean = 0, median = 0, max = 0;
+  /// \var mean
+  /// \brief Mean absolute error, rad.
+  /// \var median
+  /// \brief Median absolute error, rad.
+  /// \var max
+  /// \brief Largest absolute error, rad.
 };
 
 /// \brief Per-angle and total error statistics (formats.md section 5, `STATS`).
 struct ErrorStats {
-  std::vector<std::string> names;
-  std::vector<ErrorSummary> per_angle;
-  ErrorSummary total;
+  std::vector<std::string> names;       ///< the angles' names
+  std::vector<ErrorSummary> per_angle;  ///< one summary per angle, in names' order
+  ErrorSummary total;                   ///< over every sample of every angle
 };
 
 namespace detail {
@@ -47,6 +53,10 @@ inline ErrorSummary summarize(std::vector<double> v) {
 
 /// \brief Statistics of |simulated - measured| over all samples (rows) for each angle
 /// (column) and in total. Rows beyond the shorter of the two are ignored.
+/// \param[in] simulated N x nq simulated angles, rad.
+/// \param[in] measured N x nq measured angles, rad.
+/// \param[in] names The nq angle names.
+/// \return The statistics (the paper's Tables I-II).
 inline ErrorStats error_stats(const Eigen::MatrixXd& simulated, const Eigen::MatrixXd& measured,
                               const std::vector<std::string>& names) {
   ErrorStats out;
@@ -66,6 +76,9 @@ inline ErrorStats error_stats(const Eigen::MatrixXd& simulated, const Eigen::Mat
 }
 
 /// \brief The table as text, like the paper's Tables I-II (radians).
+/// \param[in] s The statistics.
+/// \param[in] title The first line.
+/// \return The table, one line per angle and a total line.
 inline std::string format_error_table(const ErrorStats& s, const std::string& title) {
   std::string out = title + "\n";
   char line[160];
