@@ -34,8 +34,8 @@ struct ArmFitOptions {
   /// Samples that enter the objective (weight 1) or not (0); empty = all. Used for
   /// cross-validation: the simulation still runs through every sample.
   std::vector<bool> sample_mask;
-  sim::ArmSimulationOptions simulation = default_simulation();
-  FitOptions optimiser = default_optimiser();
+  sim::ArmSimulationOptions simulation = default_simulation();  ///< integrator settings
+  FitOptions optimiser = default_optimiser();  ///< optimiser settings
 
   /// The fits' integrator tolerances. atol 1e-5 rad on the angles is 300 times below the
   /// angle sensors' noise (3e-3 rad) and about 1 % of what a finite-difference step of the
@@ -45,6 +45,7 @@ struct ArmFitOptions {
   /// instead of 7.4k steps) for no change: the closed loop on random arm 1001 took 85.6 s
   /// instead of 53.9 s with the same decisions and held-out gains to 0.1 %. Effects with a
   /// sharp feature tighten it for the models that hold them (simulate_dataset).
+  /// \return rtol 1e-6, atol 1e-5, at most 60 s per simulation.
   static sim::ArmSimulationOptions default_simulation() {
     sim::ArmSimulationOptions s;
     s.cvode.rtol = 1e-6;
@@ -52,6 +53,9 @@ struct ArmFitOptions {
     s.cvode.max_wall_seconds = 60;
     return s;
   }
+  /// \brief The fits' optimiser: a short global search, two local starts, finite-difference
+  /// steps above the integrator's noise.
+  /// \return The settings.
   static FitOptions default_optimiser() {
     FitOptions o;
     o.global_evals = 12;
@@ -68,15 +72,15 @@ struct ArmFitOptions {
 
 /// \brief Outcome of fit_arm.
 struct ArmFitResult {
-  ArmDescription fitted;
-  FitResult fit;
-  ParameterSet parameters;
+  ArmDescription fitted;    ///< the model with the fitted values
+  FitResult fit;            ///< the optimiser's result (normalised and physical values)
+  ParameterSet parameters;  ///< what was fitted, with bounds
   ErrorStats stats;  ///< on the fitting data (all samples)
   /// The fitted model simulated through every sample of the data (N x nq), masked or not;
   /// empty if that simulation failed. Callers measure held-out errors on it.
   Eigen::MatrixXd angles;
-  int simulations = 0;
-  double wall_seconds = 0;
+  int simulations = 0;      ///< simulations run by the fit
+  double wall_seconds = 0;  ///< wall-clock time of the fit
 };
 
 namespace detail {
@@ -166,6 +170,10 @@ SOFTRNE_FIT_INLINE void apply(const std::vector<ParamSlot>& slots, const Eigen::
 /// `opt`'s tolerances or tighter where the model's effects need it (effect_max_atol: a
 /// smoothed Coulomb friction needs atol 1e-6), so that every fit, screen and held-out error
 /// sees such an effect resolved whatever the caller's default.
+/// \param[in] d The arm.
+/// \param[in] data The data set (times, recorded pressures, measured angles).
+/// \param[in] opt The integrator settings.
+/// \return The simulation (result.ok false with a message if it failed).
 SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d, const io::Dataset& data,
                                                        const sim::ArmSimulationOptions& opt)
 #if SOFTRNE_FIT_BODIES
@@ -182,6 +190,9 @@ SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d, 
 
 /// \brief Checks that a data set can support a fit; throws std::invalid_argument naming the
 /// data set and what is missing.
+/// \param[in] d The arm.
+/// \param[in] data The data set.
+/// \throws std::invalid_argument if it has no angles, fewer than 20 samples or no motion.
 inline void check_fit_data(const ArmDescription& d, const io::Dataset& data) {
   if (!data.has_angles || data.angles.cols() != d.nq)
     throw std::invalid_argument(data.source + ": the data set has no measured angles for every coordinate");
@@ -199,6 +210,14 @@ inline void check_fit_data(const ArmDescription& d, const io::Dataset& data) {
 /// \brief Fits the free parameters of `start` to the measured angles of `data`, minimising the
 /// simulation error (the model is simulated from the first sample with the recorded pressures,
 /// not one step ahead). Deterministic for a given optimiser seed.
+///
+/// The parameters are eq. 23's K_spring and K_d (and optionally a gain on eq. 24's K_prs)
+/// and the effects' parameters, as the paper identifies K_spring and K_d (section IV-B).
+/// \param[in] start The model and starting values.
+/// \param[in] data The data set (with angles).
+/// \param[in] opt What to fit and how.
+/// \return The fitted model, the optimiser's result and the errors on data.
+/// \throws std::invalid_argument if data cannot support a fit (check_fit_data()).
 SOFTRNE_FIT_INLINE ArmFitResult fit_arm(const ArmDescription& start, const io::Dataset& data,
                                         const ArmFitOptions& opt = {})
 #if SOFTRNE_FIT_BODIES

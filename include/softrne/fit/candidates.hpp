@@ -39,18 +39,22 @@ namespace softrne::fit {
 /// \brief One candidate: an effect with its scope and joints at its neutral value (secondary
 /// kinds at one of their screening values).
 struct Candidate {
-  AnyEffect effect;
+  AnyEffect effect;  ///< the effect, its scope, joints and screening values
   std::vector<int> screened;  ///< indices into the effect's params moved by the screen
   std::string label;          ///< e.g. "stiffening (joint joint2)"
 };
 
 /// \brief The screen of one candidate in one fold.
 struct FoldScreen {
+  /// Relative drop of the held-out residual the linearised step predicts (file comment).
   double predicted_gain = -std::numeric_limits<double>::infinity();
   Eigen::VectorXd start;  ///< the effect's params after the Gauss-Newton step (clamped)
 };
 
 /// \brief "name (scope joints)" as the loop prints and reports a candidate.
+/// \param[in] e The candidate's effect.
+/// \param[in] d The arm (joint names).
+/// \return The label.
 inline std::string candidate_label(const AnyEffect& e, const ArmDescription& d) {
   const EffectBase& b = effect_base(e);
   std::string s = effect_name(e) + " (" + scope_name(b.scope);
@@ -107,6 +111,8 @@ inline double screening_step(const EffectBounds& b) {
 /// \brief Every effect in every allowed scope on `current`'s joints, at its neutral value,
 /// leaving out what `current` already holds. Secondary kinds are not yet resolved (see
 /// expand_secondary_kinds).
+/// \param[in] current The model so far.
+/// \return The candidate effects.
 SOFTRNE_FIT_INLINE std::vector<AnyEffect> enumerate_candidates(const ArmDescription& current)
 #if SOFTRNE_FIT_BODIES
 {
@@ -146,6 +152,14 @@ SOFTRNE_FIT_INLINE std::vector<AnyEffect> enumerate_candidates(const ArmDescript
 /// `base` + effect (all at neutral) is screened at three fixed values; the others are screened
 /// by sensitivity. Returns one Candidate per variant. Costs one simulation per kind of a
 /// multi-kind effect.
+/// \param[in] effects The candidates of enumerate_candidates().
+/// \param[in] base The model they would be added to.
+/// \param[in] base_angles Its simulated angles on data.
+/// \param[in] data The data set.
+/// \param[in] sim_opt The integrator settings.
+/// \param[in] threads The most threads to use.
+/// \param[in,out] simulations If not null, incremented by the simulations run.
+/// \return One Candidate per variant.
 SOFTRNE_FIT_INLINE std::vector<Candidate> expand_secondary_kinds(const std::vector<AnyEffect>& effects,
                                                                  const ArmDescription& base,
                                                                  const Eigen::MatrixXd& base_angles,
@@ -231,6 +245,13 @@ SOFTRNE_FIT_INLINE std::vector<Candidate> expand_secondary_kinds(const std::vect
 
 /// \brief Sensitivities of the simulated angles (flattened row-major, N*nq) to every
 /// stiffness and damping of `base` (relative step 1e-3): the nuisance columns of the screen.
+/// \param[in] base The model.
+/// \param[in] y0 Its simulated angles on data (N x nq).
+/// \param[in] data The data set.
+/// \param[in] sim_opt The integrator settings.
+/// \param[in] threads The most threads to use.
+/// \param[in,out] simulations If not null, incremented by the simulations run.
+/// \return N nq x (number of stiffnesses and dampings).
 SOFTRNE_FIT_INLINE Eigen::MatrixXd nuisance_sensitivities(const ArmDescription& base, const Eigen::MatrixXd& y0,
                                                           const io::Dataset& data,
                                                           const sim::ArmSimulationOptions& sim_opt, int threads,
@@ -271,6 +292,16 @@ SOFTRNE_FIT_INLINE Eigen::MatrixXd nuisance_sensitivities(const ArmDescription& 
 
 /// \brief Screens every candidate in one fold (see the file comment). `base` is the fold's
 /// model, `y0` its simulated angles, `fit_rows` / `held_rows` the fold's sample masks.
+/// \param[in] cands The candidates.
+/// \param[in] base The fold's model.
+/// \param[in] y0 Its simulated angles on data (N x nq).
+/// \param[in] data The data set.
+/// \param[in] fit_rows The samples the fold fits on.
+/// \param[in] held_rows The samples it holds out.
+/// \param[in] sim_opt The integrator settings.
+/// \param[in] threads The most threads to use.
+/// \param[in,out] simulations If not null, incremented by the simulations run.
+/// \return One screen per candidate, in order.
 SOFTRNE_FIT_INLINE std::vector<FoldScreen> screen_fold(const std::vector<Candidate>& cands,
                                                        const ArmDescription& base, const Eigen::MatrixXd& y0,
                                                        const io::Dataset& data, const std::vector<bool>& fit_rows,

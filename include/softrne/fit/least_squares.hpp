@@ -108,10 +108,10 @@ struct FitOptions {
   /// Called from the calling thread with (evaluations so far, best cost).
   std::function<void(int evals, double best_cost)> progress;
 
-  GlobalMethod global_method = GlobalMethod::multistart;
+  GlobalMethod global_method = GlobalMethod::multistart;  ///< the global stage
   /// Multistart: number of distinct starts refined after screening.
   int multistart_starts = 4;
-  LocalMethod local_method = LocalMethod::levenberg_marquardt;
+  LocalMethod local_method = LocalMethod::levenberg_marquardt;  ///< the local stage
   /// Central instead of forward differences in the LM Jacobian.
   bool central_differences = false;
   /// Finite-difference step in normalised coordinates; 0 means 1e-6
@@ -119,7 +119,7 @@ struct FitOptions {
   double fd_step = 0.0;
   /// Run the identifiability analysis (2p extra evaluations).
   bool compute_identifiability = true;
-  IdentifiabilityOptions identifiability;
+  IdentifiabilityOptions identifiability;  ///< settings of that analysis
 };
 
 /// \brief Outcome of fit_least_squares().
@@ -144,7 +144,7 @@ struct FitResult {
   Eigen::MatrixXd correlation;          ///< from the pseudo-inverse covariance
   Eigen::VectorXd singular_values;      ///< of J scaled by parameter magnitude
   double condition_number = std::numeric_limits<double>::infinity();  ///< of the scaled J
-  std::vector<bool> identifiable;
+  std::vector<bool> identifiable;  ///< per parameter: determined by the data
   std::string identifiability_report;  ///< human-readable lines
 };
 
@@ -925,7 +925,12 @@ SOFTRNE_FIT_INLINE FitResult fit_impl(const ParameterSet& ps, int m, std::vector
 /// identifiability analysis at the optimum. `residual` is called from the
 /// calling thread only, so `opt.threads` is ignored here (see the
 /// ResidualFactory overload).
+/// \param params the parameters, bounds and starting values
 /// \param residual_size the fixed length \f$m\f$ of the residual.
+/// \param residual the residual function r(params)
+/// \param opt the stages' settings
+/// \return The optimum, its residual and the identifiability analysis.
+/// \throws std::invalid_argument if there are no parameters or residual_size < 1.
 SOFTRNE_FIT_INLINE FitResult fit_least_squares(const ParameterSet& params, int residual_size,
                                                const ResidualFn& residual, const FitOptions& opt = {})
 #if SOFTRNE_FIT_BODIES
@@ -943,6 +948,12 @@ SOFTRNE_FIT_INLINE FitResult fit_least_squares(const ParameterSet& params, int r
 ///        own functor from `make_residual` (called `max(1, opt.threads)`
 ///        times, on the calling thread). The result equals the serial one
 ///        bit for bit when the functors are deterministic.
+/// \param params the parameters, bounds and starting values
+/// \param residual_size the fixed length \f$m\f$ of the residual
+/// \param make_residual makes one residual functor per thread
+/// \param opt the stages' settings
+/// \return The optimum, its residual and the identifiability analysis.
+/// \throws std::invalid_argument if there are no parameters or residual_size < 1.
 SOFTRNE_FIT_INLINE FitResult fit_least_squares(const ParameterSet& params, int residual_size,
                                                const ResidualFactory& make_residual,
                                                const FitOptions& opt = {})
@@ -958,6 +969,12 @@ SOFTRNE_FIT_INLINE FitResult fit_least_squares(const ParameterSet& params, int r
 
 /// \brief Identifiability analysis alone at `result.params` (e.g. at a
 ///        hand-picked point): fills cost, rms and the identifiability fields.
+/// \param params the parameters
+/// \param residual_size the fixed length \f$m\f$ of the residual
+/// \param residual the residual function
+/// \param result in: params, the point; out: cost, rms, residual and identifiability
+/// \param io the analysis's settings
+/// \throws std::invalid_argument if the residual fails at result.params.
 SOFTRNE_FIT_INLINE void analyse_identifiability(const ParameterSet& params, int residual_size,
                                                 const ResidualFn& residual, FitResult& result,
                                                 const IdentifiabilityOptions& io = {})

@@ -19,6 +19,8 @@ namespace softrne::fit {
 /// contributes only y''' dt^3 (1e-4 rad at 100 Hz for y''' = 100 rad/s^3). The median
 /// absolute value (robust to the few samples at pressure steps where y''' is large) gives
 /// sigma = median|d3| / (0.6745 sqrt(20)). Independent of any model.
+/// \param[in] y N x n samples, one column per signal.
+/// \return One sigma per column (zero with fewer than 8 samples).
 inline Eigen::VectorXd estimate_noise_sigma(const Eigen::MatrixXd& y) {
   Eigen::VectorXd sigma = Eigen::VectorXd::Zero(y.cols());
   const Eigen::Index n = y.rows();
@@ -36,6 +38,8 @@ inline Eigen::VectorXd estimate_noise_sigma(const Eigen::MatrixXd& y) {
 
 /// \brief Median absolute error that pure N(0, sigma^2) noise gives: 0.6745 sigma. A
 /// simulation whose median error reaches it has nothing systematic left to explain.
+/// \param[in] sigma The noise's standard deviation.
+/// \return 0.6745 sigma.
 inline double noise_floor_median(double sigma) { return 0.6744897501960817 * sigma; }
 
 }  // namespace softrne::fit

@@ -17,6 +17,10 @@ namespace softrne::fit {
 /// first exception thrown by a task stops the handing out of further tasks and is rethrown
 /// here after all threads joined. A thread that cannot be started leaves its share to the
 /// others.
+/// \param[in] n The number of tasks.
+/// \param[in] threads The most threads to use (the calling thread included).
+/// \param[in] task The task, called as task(k, w).
+/// \throws The first exception a task threw.
 inline void parallel_for_workers(int n, int threads, const std::function<void(int, int)>& task) {
   const int workers = std::max(1, std::min(threads, n));
   if (workers == 1) {
@@ -49,6 +53,10 @@ inline void parallel_for_workers(int n, int threads, const std::function<void(in
 }
 
 /// \brief Calls `task(k)` for k = 0..n-1 on up to `threads` threads (see parallel_for_workers).
+/// \param[in] n The number of tasks.
+/// \param[in] threads The most threads to use (the calling thread included).
+/// \param[in] task The task, called as task(k).
+/// \throws The first exception a task threw.
 inline void parallel_for(int n, int threads, const std::function<void(int)>& task) {
   parallel_for_workers(n, threads, [&](int k, int) { task(k); });
 }

@@ -20,10 +20,10 @@ namespace softrne::fit {
 /// Invariants (checked by ParameterSet::add): `lower < upper`, both finite;
 /// `lower > 0` when `log_scale`; `initial` is clamped into `[lower, upper]`.
 struct Parameter {
-  std::string name;
-  double initial = 0.0;
-  double lower = 0.0;
-  double upper = 1.0;
+  std::string name;      ///< unique within its ParameterSet
+  double initial = 0.0;  ///< the starting value
+  double lower = 0.0;    ///< the smallest allowed value
+  double upper = 1.0;    ///< the largest allowed value
   /// Search in \f$\log x\f$ (for positive quantities spanning decades).
   bool log_scale = false;
 };
@@ -40,11 +40,15 @@ class ParameterSet {
   ParameterSet() = default;
 
   /// \brief Validates and adds each parameter (see add()).
+  /// \param[in] parameters The parameters, in order.
+  /// \throws std::invalid_argument as add().
   explicit ParameterSet(const std::vector<Parameter>& parameters) {
     for (const Parameter& p : parameters) add(p);
   }
 
   /// \brief Validates and appends a parameter; returns its index.
+  /// \param[in] p The parameter.
+  /// \return Its index.
   /// \throws std::invalid_argument on an empty or duplicate name, non-finite
   ///         values, `lower >= upper`, or `lower <= 0` with `log_scale`.
   ///         An `initial` outside the bounds is clamped and a note recorded.
@@ -72,25 +76,37 @@ class ParameterSet {
     return static_cast<int>(parameters_.size()) - 1;
   }
 
-  /// \brief Number of parameters \f$p\f$.
+  /// \return The number of parameters \f$p\f$.
   int size() const { return static_cast<int>(parameters_.size()); }
+  /// \param[in] i An index, 0 <= i < size().
+  /// \return Parameter i.
+  /// \throws std::out_of_range if i is out of range.
   const Parameter& operator[](int i) const { return parameters_.at(static_cast<std::size_t>(i)); }
+  /// \return All parameters, in order.
   const std::vector<Parameter>& parameters() const { return parameters_; }
-  /// \brief Notes written during validation (clamped initial values).
+  /// \return Notes written during validation (clamped initial values).
   const std::vector<std::string>& notes() const { return notes_; }
 
   /// \brief Index of the parameter called `name`, or -1.
+  /// \param[in] name A parameter name.
+  /// \return Its index, or -1.
   int index_of(const std::string& name) const {
     for (std::size_t i = 0; i < parameters_.size(); ++i)
       if (parameters_[i].name == name) return static_cast<int>(i);
     return -1;
   }
 
+  /// \return The initial values, in order.
   Eigen::VectorXd initial() const { return collect(&Parameter::initial); }
+  /// \return The lower bounds, in order.
   Eigen::VectorXd lower() const { return collect(&Parameter::lower); }
+  /// \return The upper bounds, in order.
   Eigen::VectorXd upper() const { return collect(&Parameter::upper); }
 
   /// \brief \f$u_i(x_i)\f$; values outside the bounds are clamped first.
+  /// \param[in] i A parameter index.
+  /// \param[in] x A physical value.
+  /// \return Its normalised coordinate in [0, 1].
   double to_normalised(int i, double x) const {
     const Parameter& p = (*this)[i];
     x = std::clamp(x, p.lower, p.upper);
@@ -101,6 +117,9 @@ class ParameterSet {
   }
 
   /// \brief \f$x_i(u_i)\f$; `u` is clamped into [0, 1] and the result into the bounds.
+  /// \param[in] i A parameter index.
+  /// \param[in] u A normalised coordinate.
+  /// \return The physical value.
   double to_physical(int i, double u) const {
     const Parameter& p = (*this)[i];
     u = std::clamp(u, 0.0, 1.0);
@@ -111,6 +130,9 @@ class ParameterSet {
   }
 
   /// \brief Element-wise to_normalised().
+  /// \param[in] x The physical values (size()).
+  /// \return The normalised coordinates.
+  /// \throws std::invalid_argument if x has another size.
   Eigen::VectorXd to_normalised(const Eigen::VectorXd& x) const {
     check_size(x);
     Eigen::VectorXd u(size());
@@ -119,6 +141,9 @@ class ParameterSet {
   }
 
   /// \brief Element-wise to_physical().
+  /// \param[in] u The normalised coordinates (size()).
+  /// \return The physical values.
+  /// \throws std::invalid_argument if u has another size.
   Eigen::VectorXd to_physical(const Eigen::VectorXd& u) const {
     check_size(u);
     Eigen::VectorXd x(size());
@@ -127,6 +152,9 @@ class ParameterSet {
   }
 
   /// \brief \f$dx_i/du_i\f$ at physical value `x` (chain rule for Jacobians).
+  /// \param[in] i A parameter index.
+  /// \param[in] x A physical value.
+  /// \return The derivative.
   double dphysical_dnormalised(int i, double x) const {
     const Parameter& p = (*this)[i];
     return p.log_scale ? x * (std::log(p.upper) - std::log(p.lower)) : (p.upper - p.lower);

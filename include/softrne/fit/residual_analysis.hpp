@@ -22,24 +22,31 @@ namespace softrne::fit {
 
 /// \brief One coordinate's unexplained residual.
 struct CoordinateResidual {
-  std::string name;
+  std::string name;  ///< the coordinate's name (u1, ...)
   double median = 0;       ///< median |measured - simulated| (rad)
   double floor = 0;        ///< what sensor noise alone gives (rad)
   double ratio = 0;        ///< median / floor
   double corr_q = 0, corr_qdot = 0, corr_drive = 0, corr_drive_rate = 0;  ///< Pearson r
   /// Fractions of the residual's power below 0.5 Hz, 0.5-2 Hz, 2-10 Hz, above 10 Hz.
   std::vector<double> band_power;
+  /// \var corr_q
+  /// \brief Pearson r of the residual with q.
+  /// \var corr_qdot
+  /// \brief Pearson r of the residual with qdot.
+  /// \var corr_drive
+  /// \brief Pearson r of the residual with the drive K_prs p (eq. 24).
 };
 
 /// \brief The statement of the report: which coordinates are clearly above the floor.
 struct UnexplainedResidual {
   double threshold = 1.5;  ///< a coordinate is "clearly above" when ratio > threshold
-  std::vector<CoordinateResidual> coordinates;
-  bool above_floor = false;
-  std::string statement;
+  std::vector<CoordinateResidual> coordinates;  ///< one per coordinate
+  bool above_floor = false;  ///< some coordinate is clearly above its noise floor
+  std::string statement;     ///< the report's one-sentence conclusion
 };
 
 /// \brief Band edges (Hz) of CoordinateResidual::band_power.
+/// \return {0.5, 2, 10}.
 inline std::vector<double> residual_band_edges() { return {0.5, 2.0, 10.0}; }
 
 namespace detail {
@@ -90,6 +97,8 @@ SOFTRNE_FIT_INLINE std::vector<double> band_fractions(const Eigen::VectorXd& t, 
 /// \param simulated simulated angles in measurement space (N x nq)
 /// \param pressures recorded pressures (N x inputs)
 /// \param sigma     sensor noise per coordinate (estimate_noise_sigma)
+/// \param threshold a coordinate is clearly above its floor when median / floor exceeds it
+/// \return The per-coordinate analysis and the statement.
 SOFTRNE_FIT_INLINE UnexplainedResidual analyse_residual(const ArmDescription& desc, const Eigen::VectorXd& t,
                                                         const Eigen::MatrixXd& measured,
                                                         const Eigen::MatrixXd& simulated,
