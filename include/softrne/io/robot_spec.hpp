@@ -76,7 +76,7 @@ struct RobotSpec {
 /// \brief Paper eq. 24: \f$\tau_u = dA(p_0 - p_1)\f$, \f$\tau_v = dA(p_2 - p_3)\f$,
 /// \f$A = \pi r^2\f$, as a 2 x 4 matrix.
 /// \param[in] chamber_distance d, from the joint's axis to a chamber's centre, m.
-/// \param[in] chamber_radius r, a chamber's radius, m.
+/// \param[in] chamber_radius r, a chamber's radius (the paper's delta, A = pi delta^2), m.
 /// \return K_prs, m^3 (N m per Pa).
 inline Eigen::Matrix<double, 2, Eigen::Dynamic> default_pressure_to_torque(double chamber_distance,
                                                                            double chamber_radius) {
