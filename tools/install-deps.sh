@@ -17,6 +17,7 @@ APT_PACKAGES=(
   nlohmann-json3-dev # JSON robot descriptions and reports: io, tools
   libgtest-dev       # tests
   libbenchmark-dev   # softrne-bench
+  doxygen            # API docs (docs/Doxyfile, tools/build-docs.sh; CI phase 1)
   cmake
   ninja-build
   g++
