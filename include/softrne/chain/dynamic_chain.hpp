@@ -165,6 +165,7 @@ struct DynamicChainData {
   std::vector<FrameMotion<Scalar>> motion;  ///< [0] base, [i+1] distal frame of segment i
   std::vector<BodyLoad<Scalar>> loads;      ///< per segment: its own body's load
   std::vector<Wrench<Scalar>> wrench;  ///< [i] at the base of segment i, [N] at the tip
+
   /// One output field per algorithm (as Pinocchio's data.tau, data.g, data.nle): rnea ->
   /// tau, gravity -> gravity_forces, bias -> bias_forces, mass_matrix_and_bias and aba ->
   /// nonlinear_forces (C qdot + G), aba and forward_dynamics -> qddot.
@@ -185,6 +186,7 @@ struct DynamicChainData {
   /// \brief Output of forward_dynamics() and aba(): the accelerations.
   MatrixQ mass_matrix;  ///< output of mass_matrix() and mass_matrix_and_bias(): M(q)
   MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
+
   /// Largest nq of a segment type (sizes `articulated`).
   static constexpr int max_segment_nq = detail::variant_max_nq<AnySegment<Scalar>>::value;
   /// Per-segment scratch of aba (articulated_body.hpp), one per segment.

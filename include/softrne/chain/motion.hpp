@@ -34,6 +34,7 @@ struct BodyLoad {
   Vector3 force = Vector3::Zero();         ///< \f$m a_c\f$ less gravity (eq. 16)
   Vector3 torque = Vector3::Zero();        ///< \f$\dot H\f$ about the centre of mass (eq. 18)
   Vector3 omega_distal = Vector3::Zero();  ///< the body's angular velocity, distal frame
+
   /// Segments made of sub-bodies only (distributed-inertia CC joint): `torque` is about the
   /// base origin instead, and the first nq entries here are the sub-bodies' loads projected
   /// on the segment's coordinates with their own Jacobians (omega_distal is unused).

@@ -41,6 +41,7 @@ class Chain {
   using Data = ChainData<Chain>;                       ///< the workspace type (make_data())
 
   std::tuple<Segments...> segments;  ///< the segments, base to tip (constants only)
+
   /// Gravitational acceleration \f$g^0\f$ in the base frame (eq. 16); for a hanging arm
   /// (base z down) set it to (0, 0, 9.81).
   Vector3 gravity = Vector3(Scalar(0), Scalar(0), Scalar(-9.81));
@@ -142,6 +143,7 @@ struct ChainData<Chain<Segments...>> {
   std::array<FrameMotion<Scalar>, N + 1> motion;  ///< [0] base, [i+1] distal frame of segment i
   std::array<BodyLoad<Scalar>, N> loads;  ///< per segment: its own body's load
   std::array<Wrench<Scalar>, N + 1> wrench;  ///< [i] at the base of segment i, [N] at the tip
+
   /// One output field per algorithm (as Pinocchio's data.tau, data.g, data.nle): rnea ->
   /// tau, gravity -> gravity_forces, bias -> bias_forces, mass_matrix_and_bias and aba ->
   /// nonlinear_forces (C qdot + G), aba and forward_dynamics -> qddot.
@@ -162,6 +164,7 @@ struct ChainData<Chain<Segments...>> {
   /// \brief Output of forward_dynamics() and aba(): the accelerations.
   typename ChainT::MatrixQ mass_matrix;  ///< output of mass_matrix(): M(q)
   typename ChainT::MatrixQ mass_factor;  ///< Cholesky factor of M (forward_dynamics)
+
   /// Per-segment scratch of aba (articulated_body.hpp).
   std::array<ArticulatedSegment<Scalar, detail::max_segment_nq<Segments...>()>, N> articulated;
 

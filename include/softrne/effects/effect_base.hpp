@@ -62,6 +62,7 @@ struct ArmJoint {
   Eigen::Vector2d stiffness = Eigen::Vector2d::Zero();  ///< first nq entries used
   Eigen::Vector2d damping = Eigen::Vector2d::Zero();  ///< first nq entries used
   Eigen::Matrix<double, 2, Eigen::Dynamic> pressure_to_torque;  ///< 2 x num_inputs (CC)
+
   /// \return True for a CC joint (two coordinates), false for a revolute joint.
   bool is_cc() const { return nq == 2; }
 };

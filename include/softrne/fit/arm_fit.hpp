@@ -29,6 +29,7 @@ struct ArmFitOptions {
   bool damping = true;         ///< per-axis K_d of every joint
   bool pressure_gain = false;  ///< one factor on K_prs per CC joint
   bool effects = true;         ///< the parameters of the model's effects
+
   /// Bounds of K and D: [x0 / range, x0 * range] around the starting guess (log scale).
   double stiffness_range = 30.0;
   /// Samples that enter the objective (weight 1) or not (0); empty = all. Used for
@@ -76,6 +77,7 @@ struct ArmFitResult {
   FitResult fit;            ///< the optimiser's result (normalised and physical values)
   ParameterSet parameters;  ///< what was fitted, with bounds
   ErrorStats stats;  ///< on the fitting data (all samples)
+
   /// The fitted model simulated through every sample of the data (N x nq), masked or not;
   /// empty if that simulation failed. Callers measure held-out errors on it.
   Eigen::MatrixXd angles;

@@ -109,9 +109,11 @@ struct FitOptions {
   std::function<void(int evals, double best_cost)> progress;
 
   GlobalMethod global_method = GlobalMethod::multistart;  ///< the global stage
+
   /// Multistart: number of distinct starts refined after screening.
   int multistart_starts = 4;
   LocalMethod local_method = LocalMethod::levenberg_marquardt;  ///< the local stage
+
   /// Central instead of forward differences in the LM Jacobian.
   bool central_differences = false;
   /// Finite-difference step in normalised coordinates; 0 means 1e-6
@@ -137,6 +139,7 @@ struct FitResult {
   int failed_evaluations = 0;                             ///< calls that failed
   bool converged = false;  ///< the local stage met xtol_rel or ftol_rel
   std::string message;     ///< what each stage did, and notes
+
   /// \f$s^2 (J^T J)^{+}\f$, \f$s^2 = 2c/(m-p)\f$, J w.r.t. physical parameters.
   Eigen::MatrixXd covariance;
   Eigen::VectorXd std_errors;           ///< sqrt(diag(covariance)); inf in the null space

@@ -24,6 +24,7 @@ struct Parameter {
   double initial = 0.0;  ///< the starting value
   double lower = 0.0;    ///< the smallest allowed value
   double upper = 1.0;    ///< the largest allowed value
+
   /// Search in \f$\log x\f$ (for positive quantities spanning decades).
   bool log_scale = false;
 };

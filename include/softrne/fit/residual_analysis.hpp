@@ -27,6 +27,7 @@ struct CoordinateResidual {
   double floor = 0;        ///< what sensor noise alone gives (rad)
   double ratio = 0;        ///< median / floor
   double corr_q = 0, corr_qdot = 0, corr_drive = 0, corr_drive_rate = 0;  ///< Pearson r
+
   /// Fractions of the residual's power below 0.5 Hz, 0.5-2 Hz, 2-10 Hz, above 10 Hz.
   std::vector<double> band_power;
   /// \var corr_q

@@ -25,6 +25,7 @@ struct CCJointSpec {
   double chamber_radius = 0.0;                          ///< m, r in A = pi r^2 (eq. 24)
   Eigen::Vector2d stiffness = Eigen::Vector2d::Zero();  ///< N m/rad, diagonal K_spring for (u, v)
   Eigen::Vector2d damping = Eigen::Vector2d::Zero();    ///< N m s/rad, diagonal K_d for (u, v)
+
   /// \brief Torque per chamber pressure, rows (u, v), one column per chamber (m^3):
   /// \f$\tau = P p\f$. Always filled: eq. 24, \f$[[dA,-dA,0,0],[0,0,dA,-dA]]\f$,
   /// unless the file gives `pressure_to_torque` (then `custom_pressure_map`).
@@ -58,6 +59,7 @@ using SegmentSpec = std::variant<CCJointSpec, RigidLinkSpec, RevoluteJointSpec>;
 struct EffectSpec {
   std::string name;  ///< the effect's name (softrne::effect_names())
   std::vector<std::string> joints;  ///< names of segments it applies to
+
   /// By name: `<kind>` (shared) or `<kind>.<joint, coordinate or pressure channel>`; the
   /// names present set the scope (formats.md section 4, read by softrne::build_arm).
   std::map<std::string, double> params;

@@ -33,6 +33,7 @@ struct ArmDescription {
   int num_inputs = 0;         ///< number of pressure inputs
   int num_effect_states = 0;  ///< number of the effects' states
   std::vector<int> effect_state_offsets;  ///< effect k's first state among them
+
   /// Consistent (Euler-Lagrange of the lumped energy) or the paper's frozen-inertia eq. 18.
   InertiaRate inertia_rate = InertiaRate::Consistent;
 

@@ -90,6 +90,7 @@ struct CCFunctions {
   Scalar g[4];    ///< g[k] = g_k, k = 0..3 (g[0] = cos(phi))
   Scalar dg[4];   ///< first derivative with respect to y = phi^2
   Scalar ddg[4];  ///< second derivative with respect to y
+
   /// Below the switch only: \f$g_4, g_5\f$ and their first derivatives (for \f$d_k\f$).
   Scalar g45[2], dg45[2];
 

@@ -112,9 +112,11 @@ struct ConstantCurvatureJoint {
   static constexpr int nq = 2;   ///< the bending angles u, v (eq. 1)
   static constexpr bool has_body = true;  ///< it carries mass
   static constexpr int max_chambers = 8;  ///< most pressure inputs (columns of K_prs)
+
   /// Quadrature disks (0: lumped).
   static constexpr int num_points = InertiaModel::num_points;
   static constexpr bool distributed = num_points > 0;  ///< the disks are sub-bodies
+
   /// What calc() fills: one lumped body, or the disks as sub-bodies.
   using Kinematics = std::conditional_t<distributed, MultiBodyKinematics<Scalar, nq, num_points>,
                                         SegmentKinematics<Scalar, nq>>;
@@ -122,6 +124,7 @@ struct ConstantCurvatureJoint {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;  ///< a 3-vector
   using Vector6 = Eigen::Matrix<Scalar, 6, 1>;  ///< a 6-vector (linear; angular)
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;  ///< a 3x3 matrix
+
   /// 2 x K map from chamber pressures to (tau_u, tau_v); at most max_chambers columns, stored
   /// inline (no heap).
   using PressureMap = Eigen::Matrix<Scalar, 2, Eigen::Dynamic, 0, 2, max_chambers>;

@@ -19,6 +19,7 @@ struct SegmentKinematics {
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;  ///< a 3x3 matrix
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;  ///< a 3-vector
   using Vector6 = Eigen::Matrix<Scalar, 6, 1>;  ///< a 6-vector (linear; angular)
+
   /// Rigid sub-bodies the own mass is made of (0: one lumped body described below, if any;
   /// see MultiBodyKinematics in sub_bodies.hpp).
   static constexpr int num_sub_bodies = 0;

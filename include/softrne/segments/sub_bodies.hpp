@@ -22,6 +22,7 @@ struct SubBodyKinematics {
   Scalar mass{0};                              ///< kg
   Matrix3 R_base_body = Matrix3::Identity();   ///< the sub-body's orientation
   Vector3 r_base_body = Vector3::Zero();       ///< its centre
+
   /// About the sub-body's centre, in base axes (\f$R I_{body} R^T\f$).
   Matrix3 inertia = Matrix3::Zero();
   Eigen::Matrix<Scalar, 3, NQ> J_v = Eigen::Matrix<Scalar, 3, NQ>::Zero();  ///< of its centre
@@ -39,6 +40,7 @@ template <class Scalar, int NQ, int NB>
 struct MultiBodyKinematics : SegmentKinematics<Scalar, NQ> {
   static_assert(NB > 0, "MultiBodyKinematics needs at least one sub-body");
   static constexpr int num_sub_bodies = NB;  ///< how many sub-bodies
+
   /// The sub-bodies (for a DistributedInertia CC joint: the quadrature disks).
   std::array<SubBodyKinematics<Scalar, NQ>, static_cast<std::size_t>(NB)> sub_bodies;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW

@@ -41,12 +41,14 @@ struct ArmSimulationOptions {
   /// How recorded pressures are read between samples (see PressureInterpolation).
   enum class PressureInterpolation { pchip, linear, zero_order_hold };
   PressureInterpolation interpolation = PressureInterpolation::pchip;  ///< PCHIP by default
+
   /// Jacobian of the state equation by forward-mode AutoDiff through the templated RNE
   /// (exact); false: CVODE's internal finite differences.
   bool autodiff_jacobian = true;
   /// How the AutoDiff Jacobian is formed (both exact; see ArmSystem::JacobianMethod).
   enum class JacobianMethod { inverse_dynamics, forward_dynamics };
   JacobianMethod jacobian_method = JacobianMethod::inverse_dynamics;  ///< the cheaper one
+
   /// Absolute tolerance of the velocities = cvode.atol * velocity_atol_factor (1/s): a
   /// velocity error dv moves the angles by about dv / omega for a mode of frequency omega.
   /// 1 gives every state the same atol.
@@ -76,6 +78,7 @@ struct ArmSimulation {
   Eigen::MatrixXd angles;  ///< N x nq (rows computed before a failure, if any)
   Eigen::MatrixXd states;  ///< N x num_states
   SimulationResult result;  ///< success, message and solver statistics
+
   /// \return True if the integration reached the end of the grid.
   bool ok() const { return result.ok; }
 };

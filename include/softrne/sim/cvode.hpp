@@ -63,11 +63,13 @@ struct CvodeOptions {
   double atol = 1e-8;           ///< absolute tolerance (all components)
   long max_steps = 100000;      ///< internal steps in total over the run
   double max_wall_seconds = 0;  ///< wall-clock limit; 0 = none
+
   /// Cancellation: when `*stop` becomes true (a tool's SIGINT handler sets it), the run
   /// fails at the next right-hand-side evaluation with "stopped on request". Null: never.
   /// A fit or the closed loop built on these runs then ends within one simulation step.
   const std::atomic<bool>* stop = nullptr;
   double max_step = 0;          ///< largest step size; 0 = CVODE default (none)
+
   /// Smallest step size; 0 = a roundoff floor, 256 eps max(1, |t0|, |t_end|).
   /// Without a floor, an rhs that fails for all t > t* makes CVODE creep up to
   /// t* until t + h == t and then spin there until max_steps is exhausted.
@@ -92,10 +94,12 @@ struct SimulationStats {
 /// \brief Output of integrate().
 struct SimulationResult {
   bool ok = false;  ///< the integration reached the last output time
+
   /// "" when ok; else one line: the reason and the time reached, e.g.
   /// "CVODE failed at t = 3.217 s: too many steps (100000)".
   std::string message;
   double t_reached = 0;  ///< last time the solution is known at
+
   /// One row per output time reached (all of them when ok), one column per state.
   Eigen::MatrixXd x;
   SimulationStats stats;  ///< solver statistics (steps, evaluations, time)
