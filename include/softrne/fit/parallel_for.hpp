@@ -20,7 +20,7 @@ namespace softrne::fit {
 /// \param[in] n The number of tasks.
 /// \param[in] threads The most threads to use (the calling thread included).
 /// \param[in] task The task, called as task(k, w).
-/// \throws The first exception a task threw.
+/// \note The first exception a task throws is rethrown here, of its own type.
 inline void parallel_for_workers(int n, int threads, const std::function<void(int, int)>& task) {
   const int workers = std::max(1, std::min(threads, n));
   if (workers == 1) {
@@ -56,7 +56,7 @@ inline void parallel_for_workers(int n, int threads, const std::function<void(in
 /// \param[in] n The number of tasks.
 /// \param[in] threads The most threads to use (the calling thread included).
 /// \param[in] task The task, called as task(k).
-/// \throws The first exception a task threw.
+/// \note The first exception a task throws is rethrown here, of its own type.
 inline void parallel_for(int n, int threads, const std::function<void(int)>& task) {
   parallel_for_workers(n, threads, [&](int k, int) { task(k); });
 }
