@@ -167,7 +167,8 @@ struct ConstantCurvatureJoint {
   /// with e_z has a closed form, so no 3x3 matrix product is formed.
   ///
   /// Eqs. 1-9 (rotation, distal position, Jacobian, its rate, centre of mass) and the
-  /// lumped inertia of eq. 19, or the disks of DistributedInertia (eqs. 19-22 integrated).
+  /// inertia: lumped, eq. 19 with eqs. 20-22 in closed form; or DistributedInertia's
+  /// quadrature disks, each with the inertia of eq. 20.
   /// \param[in] q (u, v), rad.
   /// \param[in] qdot (u', v'), rad/s (for the Jacobian rates and the inertia rate).
   /// \param[out] kin The segment's kinematics.
