@@ -57,8 +57,8 @@ inline constexpr const char* kCalibratedFalsePositiveRate =
 
 /// \brief Settings of the closed loop.
 struct LoopOptions {
-  ArmFitOptions fit{};
-  int max_effects = 4;
+  ArmFitOptions fit{};  ///< the baseline fit's and the refits' settings
+  int max_effects = 4;  ///< most rounds, so most effects added
   int candidates_to_confirm = 4;  ///< best-screened candidates refitted per round
   /// Relative drop of the held-out error a candidate must reach in every fold. Its
   /// false-positive rate on effect-free data is measured in docs/closing-the-loop.md.
@@ -80,7 +80,7 @@ struct LoopOptions {
   /// Relative difference of the held-out errors (every fold) below which two passing
   /// candidates with as many parameters are reported as equivalent (AddedEffect::equivalent).
   double equivalence_tolerance = 0.005;
-  double inertia_min_gain = 0.01;
+  double inertia_min_gain = 0.01;  ///< held-out gain distributed inertia must reach (every fold)
   /// A coordinate whose final median error exceeds this multiple of the noise floor is
   /// reported as unexplained.
   double unexplained_ratio = 1.5;
@@ -91,21 +91,21 @@ struct LoopOptions {
 struct CandidateScore {
   std::string name;   ///< the effect's name
   std::string label;  ///< name, scope and joints (and fixed secondary values)
-  Scope scope = Scope::Shared;
-  std::vector<std::string> joints;
+  Scope scope = Scope::Shared;      ///< the candidate's scope
+  std::vector<std::string> joints;  ///< names of the joints it acts on
   std::vector<double> predicted_gains;  ///< the screen, per fold
   bool confirmed = false;               ///< refitted in the folds
   std::vector<double> fold_gains;       ///< measured relative drop of the held-out error
   double cv_gain = 0;                   ///< mean of fold_gains
-  bool added = false;
+  bool added = false;                   ///< the loop added it in this round
 };
 
 /// \brief An effect the loop added.
 struct AddedEffect {
   AnyEffect effect;  ///< as first added (the refitted values are in LoopResult::final_fit)
-  std::string label;
-  std::string evidence;
-  std::vector<double> fold_gains;
+  std::string label;               ///< name, scope and joints
+  std::string evidence;            ///< one line: why it was added (or removed)
+  std::vector<double> fold_gains;  ///< relative drop of the held-out error, per fold
   double selection_gain = 0;  ///< mean held-out gain in the round it was added
   /// Candidates that passed in the same round with as many parameters and a held-out error
   /// within LoopOptions::equivalence_tolerance of this one's in every fold: the data cannot
@@ -124,23 +124,34 @@ struct InertiaChoice {
 
 /// \brief Outcome of run_loop.
 struct LoopResult {
-  ArmFitResult baseline;
+  ArmFitResult baseline;  ///< the declared model fitted (stiffness, damping)
   ErrorStats baseline_test, final_train, final_test;
+  /// \var baseline_test
+  /// \brief The baseline's errors on the test set (empty without one).
+  /// \var final_train
+  /// \brief The final model's errors on the training set.
+  /// \var final_test
+  /// \brief The final model's errors on the test set (empty without one).
   std::vector<std::vector<CandidateScore>> rounds;  ///< candidates of each round, best first
-  std::vector<AddedEffect> added;
+  std::vector<AddedEffect> added;  ///< the effects kept, in the order they were added
+
   /// Effects added in some round that no longer earned their place once later ones were in
   /// (the backward pass), with the held-out evidence of their removal.
   std::vector<AddedEffect> removed;
-  InertiaChoice inertia;
-  ArmFitResult final_fit;
+  InertiaChoice inertia;  ///< whether distributed inertia was tried and adopted
+  ArmFitResult final_fit;  ///< the final model fitted on the whole training set
   Eigen::VectorXd noise_sigma;  ///< estimated sensor noise per coordinate (rad)
   double noise_floor = 0;       ///< median |error| that noise alone gives (rad), all coordinates
   UnexplainedResidual unexplained_train, unexplained_test;
+  /// \var unexplained_train
+  /// \brief What the final model leaves unexplained on the training set.
+  /// \var unexplained_test
+  /// \brief The same on the test set (empty without one).
   Eigen::MatrixXd baseline_residual;  ///< measured - simulated on train, baseline (N x nq)
   Eigen::MatrixXd final_residual;     ///< the same after the loop
-  int folds = 2;
-  int simulations = 0;
-  double wall_seconds = 0;
+  int folds = 2;            ///< cross-validation folds
+  int simulations = 0;      ///< simulations run, all stages
+  double wall_seconds = 0;  ///< wall-clock time of run_loop
 };
 
 namespace detail {
@@ -247,6 +258,13 @@ inline bool distribute_cc_inertia(ArmDescription& d) {
 }  // namespace detail
 
 /// \brief Runs the closed loop on a training set; `test` only measures (may be null).
+/// \param[in] declared The declared model (e.g. build_arm(io::read_robot_json(...))).
+/// \param[in] train The training set (with angles): fits, screens and decisions.
+/// \param[in] test The test set, only measured; may be null.
+/// \param[in] opt The loop's settings.
+/// \return The baseline, the effects added and removed with their evidence, the final
+///   model and its errors and unexplained residuals.
+/// \throws std::invalid_argument if train cannot support a fit (check_fit_data()).
 SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io::Dataset& train,
                                        const io::Dataset* test, const LoopOptions& opt = {})
 #if SOFTRNE_FIT_BODIES
