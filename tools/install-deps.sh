@@ -15,6 +15,7 @@ APT_PACKAGES=(
   libsundials-dev    # SUNDIALS 6 CVODE: softrne::sim
   libnlopt-cxx-dev   # NLopt (C and C++ API): softrne::fit
   nlohmann-json3-dev # JSON robot descriptions and reports: io, tools
+  libcli11-dev       # CLI11, the command lines of tools/ (header-only; not the library's)
   libgtest-dev       # tests
   libbenchmark-dev   # softrne-bench
   doxygen            # API docs (docs/Doxyfile, tools/build-docs.sh; CI phase 1)

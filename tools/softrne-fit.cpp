@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "common/cli.hpp"
+#include "common/outputs.hpp"
 #include "common/report.hpp"
 #include "softrne/fit/arm_fit.hpp"
 #include "softrne/io/csv.hpp"
@@ -11,37 +12,55 @@
 int main(int argc, char** argv) {
   using namespace softrne;
   return cli::run("softrne-fit", [&] {
-    cli::ArgParser args("softrne-fit", "--robot R.json --data train.csv --out fitted.json [--test test.csv]",
-                        "Fits the per-axis stiffness and damping of every joint (and the parameters of the "
-                        "robot's effects) to measured angles by simulation error: the model is simulated from "
-                        "the first sample with the recorded pressures. Prints the fitted values with their "
-                        "standard errors and the error tables (paper Tables I-II) before and after.");
-    args.option("robot", "R.json", "robot description (softrne-robot/1); its values are the starting guesses").required();
-    args.option("data", "train.csv", "pressures and measured angles").required();
-    args.option("out", "fitted.json", "where to write the fitted robot").required();
-    args.option("test", "test.csv", "a held-out data set: only measured, never fitted");
-    args.flag("pressure-gain", "also fit one gain on K_prs per CC joint");
-    args.option("seed", "N", "optimiser seed (default 1)");
-    args.option("threads", "N", "parallel simulations (default 2)");
-    args.flag("quiet", "no progress line");
-    if (!args.parse(argc, argv)) return cli::kExitOk;
-    cli::check_outputs_are_not_inputs(args, {"robot", "data", "test"}, {"out"});
-    const io::RobotSpec spec = io::read_robot_json(args.value("robot"));
-    const io::Dataset train = io::read_dataset(args.value("data"), spec, true);
+    cli::App app(
+        "softrne-fit", "--robot R.json --data train.csv --out fitted.json [--test test.csv]",
+        "Fits the per-axis stiffness and damping of every joint (and the parameters of the "
+        "robot's effects) to measured angles by simulation error: the model is simulated from "
+        "the first sample with the recorded pressures. Prints the fitted values with their "
+        "standard errors and the error tables (paper Tables I-II) before and after.");
+    std::string robot_path, data_path, out_path, test_path;
+    fit::ArmFitOptions opt;
+    app.add_option("--robot", robot_path,
+                   "robot description (softrne-robot/1); its values are the starting guesses")
+        ->type_name("R.json")
+        ->required();
+    app.add_option("--data", data_path, "pressures and measured angles")
+        ->type_name("train.csv")
+        ->required();
+    app.add_option("--out", out_path, "where to write the fitted robot")
+        ->type_name("fitted.json")
+        ->required();
+    app.add_option("--test", test_path, "a held-out data set: only measured, never fitted")
+        ->type_name("test.csv");
+    app.add_flag("--pressure-gain", opt.pressure_gain, "also fit one gain on K_prs per CC joint");
+    app.add_option("--seed", opt.optimiser.seed, "optimiser seed")
+        ->type_name("N")
+        ->capture_default_str()
+        ->transform(cli::DecimalInteger)
+        ->check(CLI::Range(0L, 4294967295L));
+    opt.optimiser.threads = 2;
+    app.add_option("--threads", opt.optimiser.threads, "parallel simulations")
+        ->type_name("N")
+        ->capture_default_str()
+        ->transform(cli::DecimalInteger)
+        ->check(CLI::Range(1, 64));
+    bool quiet = false;
+    app.add_flag("--quiet", quiet, "no progress line");
+    if (!app.parse_command_line(argc, argv)) return cli::kExitOk;
+    cli::check_outputs_are_not_inputs(
+        {{"--robot", robot_path}, {"--data", data_path}, {"--test", test_path}},
+        {{"--out", out_path}});
+    const io::RobotSpec spec = io::read_robot_json(robot_path);
+    const io::Dataset train = io::read_dataset(data_path, spec, true);
     io::Dataset test;
-    const bool has_test = args.has("test");
-    if (has_test) test = io::read_dataset(args.value("test"), spec, true);
+    const bool has_test = !test_path.empty();
+    if (has_test) test = io::read_dataset(test_path, spec, true);
     ArmDescription desc;
     try {
       desc = build_arm(spec);
     } catch (const std::invalid_argument& e) {
-      throw cli::Failure(args.value("robot") + ": " + e.what());
+      throw cli::Failure(robot_path + ": " + e.what());
     }
-    fit::ArmFitOptions opt;
-    opt.pressure_gain = args.has("pressure-gain");
-    opt.optimiser.seed = static_cast<unsigned>(args.integer("seed", 1, 0, 4294967295L));
-    opt.optimiser.threads = static_cast<int>(args.integer("threads", 2, 1, 64));
-    const bool quiet = args.has("quiet");
     if (!quiet)
       opt.optimiser.progress = [nq = desc.nq](int evals, double cost) {
         // The residual is scaled so that 2 cost = nq * (mean squared angle error).
@@ -65,7 +84,7 @@ int main(int argc, char** argv) {
     cli::throw_if_interrupted("the fit");
     if (!quiet) std::fprintf(stderr, "\n");
     if (!std::isfinite(r.fit.cost)) throw cli::Failure(train.source + ": the fit found no parameters that simulate: " + r.fit.message);
-    io::write_robot_json(to_robot_spec(r.fitted), args.value("out"));
+    io::write_robot_json(to_robot_spec(r.fitted), out_path);
     std::printf("fitted %d parameters in %.1f s (%d simulations)\n", r.parameters.size(), r.wall_seconds, r.simulations);
     std::printf("%s", cli::parameter_table(r).c_str());
     if (!r.fit.identifiability_report.empty()) std::printf("identifiability:\n%s\n", r.fit.identifiability_report.c_str());
@@ -77,7 +96,7 @@ int main(int argc, char** argv) {
       if (!s.ok()) throw cli::Failure(test.source + ": the fitted model fails to simulate: " + s.result.message);
       std::printf("%s", format_error_table(error_stats(s.angles, test.angles, r.fitted.coordinate_names), "test, after").c_str());
     }
-    std::printf("wrote %s\n", args.value("out").c_str());
+    std::printf("wrote %s\n", out_path.c_str());
     return cli::kExitOk;
   });
 }

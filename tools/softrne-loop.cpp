@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "common/cli.hpp"
+#include "common/outputs.hpp"
 #include "common/report.hpp"
 #include "softrne/fit/loop.hpp"
 #include "softrne/io/csv.hpp"
@@ -50,37 +51,61 @@ void write_plot_data(const std::string& dir, const softrne::fit::LoopResult& r, 
 int main(int argc, char** argv) {
   using namespace softrne;
   return cli::run("softrne-loop", [&] {
-    cli::ArgParser args("softrne-loop", "--robot R.json --train train.csv --test test.csv --out report.json [--plots DIR]",
-                        "Fits the declared model, screens every effect in every scope by its predicted held-out "
-                        "simulation error, refits the best in cross-validation folds of the training data, adds "
-                        "those that lower the held-out error in every fold, refits, and reports the error before "
-                        "and after, the sensor noise floor and what stays unexplained "
-                        "(docs/closing-the-loop.md). The test data only measures.");
-    args.option("robot", "R.json", "robot description (softrne-robot/1)").required();
-    args.option("train", "train.csv", "training data (pressures and measured angles)").required();
-    args.option("test", "test.csv", "test data: measured only, never used to select").required();
-    args.option("out", "report.json", "the report (softrne-loop-report/2)").required();
-    args.option("plots", "DIR",
-                "also write the data for plots and draw them with tools/plot_loop.py (python3 with numpy and "
-                "matplotlib; another interpreter via the environment variable SOFTRNE_PYTHON)");
-    args.option("threads", "N", "parallel simulations (default 2)");
-    args.option("max-effects", "N", "at most this many effects (default 4)");
-    args.flag("quiet", "no progress lines");
-    if (!args.parse(argc, argv)) return cli::kExitOk;
-    cli::check_outputs_are_not_inputs(args, {"robot", "train", "test"}, {"out"});
-    const io::RobotSpec spec = io::read_robot_json(args.value("robot"));
-    const io::Dataset train = io::read_dataset(args.value("train"), spec, true);
-    const io::Dataset test = io::read_dataset(args.value("test"), spec, true);
+    cli::App app(
+        "softrne-loop",
+        "--robot R.json --train train.csv --test test.csv --out report.json [--plots DIR]",
+        "Fits the declared model, screens every effect in every scope by its predicted held-out "
+        "simulation error, refits the best in cross-validation folds of the training data, adds "
+        "those that lower the held-out error in every fold, refits, and reports the error before "
+        "and after, the sensor noise floor and what stays unexplained "
+        "(docs/closing-the-loop.md). The test data only measures.");
+    std::string robot_path, train_path, test_path, out_path, plots_dir;
+    fit::LoopOptions opt;
+    app.add_option("--robot", robot_path, "robot description (softrne-robot/1)")
+        ->type_name("R.json")
+        ->required();
+    app.add_option("--train", train_path, "training data (pressures and measured angles)")
+        ->type_name("train.csv")
+        ->required();
+    app.add_option("--test", test_path, "test data: measured only, never used to select")
+        ->type_name("test.csv")
+        ->required();
+    app.add_option("--out", out_path, "the report (softrne-loop-report/2)")
+        ->type_name("report.json")
+        ->required();
+    app.add_option("--plots", plots_dir,
+                   "also write the data for plots and draw them with tools/plot_loop.py (python3 "
+                   "with numpy and matplotlib; another interpreter via the environment variable "
+                   "SOFTRNE_PYTHON)")
+        ->type_name("DIR");
+    opt.fit.optimiser.threads = 2;
+    app.add_option("--threads", opt.fit.optimiser.threads, "parallel simulations")
+        ->type_name("N")
+        ->capture_default_str()
+        ->transform(cli::DecimalInteger)
+        ->check(CLI::Range(1, 64));
+    app.add_option("--max-effects", opt.max_effects, "at most this many effects")
+        ->type_name("N")
+        ->capture_default_str()
+        ->transform(cli::DecimalInteger)
+        ->check(CLI::Range(0, 16));
+    bool quiet = false;
+    app.add_flag("--quiet", quiet, "no progress lines");
+    if (!app.parse_command_line(argc, argv)) return cli::kExitOk;
+    cli::check_outputs_are_not_inputs(
+        {{"--robot", robot_path}, {"--train", train_path}, {"--test", test_path}},
+        {{"--out", out_path}});
+    const io::RobotSpec spec = io::read_robot_json(robot_path);
+    const io::Dataset train = io::read_dataset(train_path, spec, true);
+    const io::Dataset test = io::read_dataset(test_path, spec, true);
     ArmDescription desc;
     try {
       desc = build_arm(spec);
     } catch (const std::invalid_argument& e) {
-      throw cli::Failure(args.value("robot") + ": " + e.what());
+      throw cli::Failure(robot_path + ": " + e.what());
     }
-    fit::LoopOptions opt;
-    opt.fit.optimiser.threads = static_cast<int>(args.integer("threads", 2, 1, 64));
-    opt.max_effects = static_cast<int>(args.integer("max-effects", 4, 0, 16));
-    if (!args.has("quiet")) opt.log = [](const std::string& s) { std::fprintf(stderr, "softrne-loop: %s\n", s.c_str()); };
+    if (!quiet)
+      opt.log = [](const std::string& s) { std::fprintf(stderr, "softrne-loop: %s\n", s.c_str()); };
     fit::LoopResult r;
     cli::stop_on_interrupt();
     opt.fit.simulation.cvode.stop = &cli::interrupted;
@@ -90,8 +115,8 @@ int main(int argc, char** argv) {
       throw cli::Failure(e.what());
     }
     cli::throw_if_interrupted("the closed loop");
-    if (args.has("plots")) write_plot_data(args.value("plots"), r, train, test, opt);
-    io::detail::write_text_file(args.value("out"), cli::loop_report_json(r, true, opt).dump(2) + "\n");
+    if (!plots_dir.empty()) write_plot_data(plots_dir, r, train, test, opt);
+    io::detail::write_text_file(out_path, cli::loop_report_json(r, true, opt).dump(2) + "\n");
     std::printf("closed loop in %.1f s (%d simulations)\n", r.wall_seconds, r.simulations);
     std::printf("sensor noise estimated from the training angles: floor (median |error| of noise alone) %.4f rad\n",
                 r.noise_floor);
@@ -130,8 +155,8 @@ int main(int argc, char** argv) {
     std::printf("%s", format_error_table(r.final_train, "train, final").c_str());
     std::printf("%s", format_error_table(r.baseline_test, "test, baseline").c_str());
     std::printf("%s", format_error_table(r.final_test, "test, final").c_str());
-    std::printf("test median error: %.4f -> %.4f rad\nwrote %s\n", r.baseline_test.total.median, r.final_test.total.median,
-                args.value("out").c_str());
+    std::printf("test median error: %.4f -> %.4f rad\nwrote %s\n", r.baseline_test.total.median,
+                r.final_test.total.median, out_path.c_str());
     return cli::kExitOk;
   });
 }

@@ -29,7 +29,8 @@ std::vector<gen::EffectRequest> parse_effects(const std::string& text) {
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
-    if (item.empty()) throw UsageError("option --effects: empty item in " + softrne::io::detail::quoted(text));
+    if (item.empty())
+      throw UsageError("--effects: empty item in " + softrne::io::detail::quoted(text));
     gen::EffectRequest r;
     const auto colon = item.find(':');
     r.name = item.substr(0, colon);
@@ -38,7 +39,7 @@ std::vector<gen::EffectRequest> parse_effects(const std::string& text) {
     if (!info) {
       std::string list;
       for (const auto& e : gen::effect_table()) list += (list.empty() ? "" : ", ") + e.name;
-      throw UsageError("option --effects: unknown effect " + softrne::io::detail::quoted(r.name) +
+      throw UsageError("--effects: unknown effect " + softrne::io::detail::quoted(r.name) +
                        " (one of " + list + ")");
     }
     if (!r.scope.empty()) {
@@ -49,14 +50,14 @@ std::vector<gen::EffectRequest> parse_effects(const std::string& text) {
         list += (list.empty() ? "" : ", ") + s;
       }
       if (!ok)
-        throw UsageError("option --effects: effect '" + r.name + "' has no scope " +
+        throw UsageError("--effects: effect '" + r.name + "' has no scope " +
                          softrne::io::detail::quoted(r.scope) + " (one of " + list + ")");
     }
     for (const auto& o : out)
-      if (o.name == r.name) throw UsageError("option --effects: effect '" + r.name + "' given twice");
+      if (o.name == r.name) throw UsageError("--effects: effect '" + r.name + "' given twice");
     out.push_back(r);
   }
-  if (out.empty()) throw UsageError("option --effects: no effect given");
+  if (out.empty()) throw UsageError("--effects: no effect given");
   return out;
 }
 
@@ -140,53 +141,71 @@ int list_effects() {
 }
 
 int run(int argc, char** argv) {
-  softrne::cli::ArgParser args(
+  using softrne::cli::FiniteNumber;
+  softrne::cli::App app(
       kTool, "--seed N (--effects NAME[:SCOPE],... | --none) --out DIR [options]",
-      "Draws a random soft arm (1-4 CC joints, links, maybe a revolute joint; hanging, wall-mounted\n"
-      "or upright) from the seed, injects the effects asked for at random strengths that are\n"
-      "clearly present, and writes DIR/robot.json (the declared model: lumped inertia, no effects,\n"
-      "stiffness and damping off by up to 1.5x), DIR/truth.json (the true model: distributed\n"
-      "inertia, the effects), DIR/case.json (what was injected, noise, mounting) and DIR/train.csv\n"
-      "(random pressure steps) and DIR/test.csv (smooth inputs), 100 Hz, simulated through the\n"
-      "truth (rtol 1e-8, atol 1e-9) plus sensor noise. The same seed gives the same arm whatever\n"
-      "the effects. See tools/common/random_arm.hpp for the distributions and strength rules.");
-  args.option("seed", "N", "case seed (non-negative integer; required)");
-  args.option("effects", "LIST",
-              "effects to inject, comma separated, each NAME or NAME:SCOPE (scope: shared, joint, "
-              "coordinate, chamber; drawn at random when absent); see --list-effects");
-  args.flag("none", "inject nothing: an effect-free control case");
-  args.option("out", "DIR", "output folder (created if needed)");
-  args.option("train-seconds", "S", "length of the train record").default_value("10");
-  args.option("test-seconds", "S", "length of the test record").default_value("10");
-  args.option("angle-noise", "RAD", "standard deviation of the angle sensor noise").default_value("0.003");
-  args.option("pressure-noise", "PA", "standard deviation of the pressure sensor noise").default_value("300");
-  args.flag("no-calibrate", "keep the drawn effect strengths (no adjustment to the impact band)");
-  args.flag("list-effects",
-            "print the effect table (name, scope, whether this build of the library accepts it, "
-            "parameters, strength rule) as tab-separated lines and exit");
-  args.flag("quiet", "print nothing on success");
-  args.epilog(
-      "example:\n"
+      "Draws a random soft arm (1-4 CC joints, links, maybe a revolute joint; hanging, "
+      "wall-mounted or upright) from the seed, injects the effects asked for at random "
+      "strengths that are clearly present, and writes DIR/robot.json (the declared model: "
+      "lumped inertia, no effects, stiffness and damping off by up to 1.5x), DIR/truth.json "
+      "(the true model: distributed inertia, the effects), DIR/case.json (what was injected, "
+      "noise, mounting) and DIR/train.csv (random pressure steps) and DIR/test.csv (smooth "
+      "inputs), 100 Hz, simulated through the truth (rtol 1e-8, atol 1e-9) plus sensor noise. "
+      "The same seed gives the same arm whatever the effects. See tools/common/random_arm.hpp "
+      "for the distributions and strength rules.",
       "  softrne-make-case --seed 7 --effects stiffening:joint,actuator_lag --out case7\n"
       "  softrne-loop --robot case7/robot.json --train case7/train.csv --test case7/test.csv \\\n"
-      "               --out case7/report.json\n\n" +
-      softrne::cli::ArgParser::exit_code_text());
-  if (!args.parse(argc, argv)) return softrne::cli::kExitOk;
-  if (args.has("list-effects")) return list_effects();
-  if (!args.has("seed")) throw UsageError("missing required option --seed N");
-  if (!args.has("out")) throw UsageError("missing required option --out DIR");
-  if (args.has("effects") == args.has("none"))
-    throw UsageError("give exactly one of --effects LIST and --none");
-
+      "               --out case7/report.json");
   gen::CaseOptions opt;
-  opt.seed = static_cast<std::uint64_t>(args.integer("seed", 0, 0, 2147483647L));
-  if (args.has("effects")) opt.effects = parse_effects(args.value("effects"));
-  opt.train_seconds = args.number("train-seconds", 10, 3, 600);
-  opt.test_seconds = args.number("test-seconds", 10, 3, 600);
-  opt.angle_noise = args.number("angle-noise", 0.003, 0, 1);
-  opt.pressure_noise = args.number("pressure-noise", 300, 0, 1e5);
-  opt.calibrate = !args.has("no-calibrate");
-  const std::string out = args.value("out");
+  std::string effects, out;
+  bool none = false, no_calibrate = false, quiet = false, list = false;
+  app.add_option("--seed", opt.seed, "case seed")
+      ->type_name("N")
+      ->required()
+      ->transform(softrne::cli::DecimalInteger)
+      ->check(CLI::Range(0L, 2147483647L));
+  CLI::App* inject = app.add_option_group("injection", "what to inject");
+  inject
+      ->add_option(
+          "--effects", effects,
+          "effects to inject, comma separated, each NAME or NAME:SCOPE (scope: shared, joint, "
+          "coordinate, chamber; drawn at random when absent); see --list-effects")
+      ->type_name("LIST");
+  inject->add_flag("--none", none, "inject nothing: an effect-free control case");
+  inject->require_option(1);
+  app.add_option("--out", out, "output folder (created if needed)")->type_name("DIR")->required();
+  app.add_option("--train-seconds", opt.train_seconds, "length of the train record")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(FiniteNumber(3, 600));
+  app.add_option("--test-seconds", opt.test_seconds, "length of the test record")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(FiniteNumber(3, 600));
+  app.add_option("--angle-noise", opt.angle_noise, "standard deviation of the angle sensor noise")
+      ->type_name("RAD")
+      ->capture_default_str()
+      ->check(FiniteNumber(0, 1));
+  app.add_option("--pressure-noise", opt.pressure_noise,
+                 "standard deviation of the pressure sensor noise")
+      ->type_name("PA")
+      ->capture_default_str()
+      ->check(FiniteNumber(0, 1e5));
+  app.add_flag("--no-calibrate", no_calibrate,
+               "keep the drawn effect strengths (no adjustment to the impact band)");
+  app.add_flag_callback(
+         "--list-effects",
+         [&list] {
+           list = true;
+           throw CLI::Success();
+         },
+         "print the effect table (name, scope, whether this build of the library accepts it, "
+         "parameters, strength rule) as tab-separated lines and exit (whatever else is given)")
+      ->trigger_on_parse();
+  app.add_flag("--quiet", quiet, "print nothing on success");
+  if (!app.parse_command_line(argc, argv)) return list ? list_effects() : softrne::cli::kExitOk;
+  if (!effects.empty()) opt.effects = parse_effects(effects);
+  opt.calibrate = !no_calibrate;
 
   gen::Case c;
   try {
@@ -195,7 +214,7 @@ int run(int argc, char** argv) {
     throw Failure("effect '" + e.effect + "' is not accepted by this build of softrne (build_arm: " +
                   e.what() + "); softrne-make-case --list-effects shows what builds");
   } catch (const std::invalid_argument& e) {
-    throw UsageError(std::string("option --effects: ") + e.what());
+    throw UsageError(std::string("--effects: ") + e.what());
   } catch (const std::runtime_error& e) {
     throw Failure(e.what());
   }
@@ -216,7 +235,7 @@ int run(int argc, char** argv) {
   write_dataset(out + "/train.csv", c.train, comments);
   write_dataset(out + "/test.csv", c.test, comments);
   softrne::io::detail::write_text_file(out + "/case.json", case_json(c).dump(2) + "\n");
-  if (!args.has("quiet")) {
+  if (!quiet) {
     std::string effs;
     for (const auto& e : c.effects) {
       char buf[160];

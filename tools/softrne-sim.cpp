@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "common/cli.hpp"
+#include "common/outputs.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
 #include "softrne/model/arm_model.hpp"
@@ -24,7 +25,6 @@ namespace {
 constexpr const char* kTool = "softrne-sim";
 
 using softrne::cli::Failure;
-using softrne::cli::UsageError;
 using PI = softrne::sim::ArmSimulationOptions::PressureInterpolation;
 
 /// Progress on stderr: only on a terminal, only once the run has taken a second, at most
@@ -61,77 +61,89 @@ class Progress {
 };
 
 int run_sim(int argc, char** argv) {
-  softrne::cli::ArgParser args(
+  using softrne::cli::FiniteNumber;
+  softrne::cli::App app(
       kTool, "--robot R.json --pressures P.csv [--out S.csv] [options]",
-      "Simulates the arm described by R.json from rest at the first row of P.csv (its measured\n"
-      "angles, or zero) under the recorded chamber pressures of P.csv, with CVODE (BDF,\n"
-      "Jacobian by automatic differentiation). Writes t,u1,v1,... on the input's time grid\n"
-      "(--out); where P.csv also holds measured angles, prints the error table (mean, median\n"
-      "and max absolute error per angle, rad). Then prints the real-time factor (simulated\n"
-      "seconds per wall-clock second) and the solver's counters.");
-  args.option("robot", "R.json", "robot description (softrne-robot/1)").required();
-  args.option("pressures", "P.csv", "recorded pressures: t,p1_0,...; angles u1,v1,... optional")
-      .required();
-  args.option("out", "S.csv",
-              "write the simulated angles here ('-' = stdout; the report then "
-              "goes to stderr)");
-  const softrne::sim::ArmSimulationOptions defaults;
-  const double def_rtol = defaults.cvode.rtol, def_atol = defaults.cvode.atol;
-  const double def_vf = defaults.velocity_atol_factor;
-  args.option("rtol", "X", "relative tolerance of the integrator")
-      .default_value(softrne::io::detail::format_double(def_rtol));
-  args.option("atol", "X",
-              "absolute tolerance of the angles (rad); well below the angle "
-              "sensors' noise")
-      .default_value(softrne::io::detail::format_double(def_atol));
-  args.option("atol-velocity", "X", "absolute tolerance of the angular velocities (rad/s)")
-      .default_value(softrne::io::detail::format_double(def_vf) + " x atol");
-  args.option("interpolation", "MODE",
-              "recorded pressures between samples: pchip (C1, no overshoot), linear, zoh")
-      .default_value("pchip");
-  args.option("smooth", "SIGMA",
-              "OPTIONAL pre-smoothing of the recorded pressures by a Gaussian kernel of standard "
-              "deviation SIGMA seconds (zero phase). Changes the model's input: removes sensor "
-              "noise the integrator would otherwise resolve (faster), rounds off steps")
-      .default_value("off");
-  args.option("jacobian", "METHOD",
-              "Jacobian for the integrator's Newton iteration: ad (AutoDiff through inverse "
-              "dynamics), ad-forward (AutoDiff through forward dynamics), fd (CVODE's "
-              "differences)")
-      .default_value("ad");
-  args.option("max-steps", "N", "integrator step limit").default_value("max(1e5, 1e4 per s)");
-  args.flag("quiet",
-            "no progress indicator (shown on a terminal for runs over a second) and no solver "
-            "statistics; the error table stays");
-  args.epilog(
-      "example:\n"
+      "Simulates the arm described by R.json from rest at the first row of P.csv (its measured "
+      "angles, or zero) under the recorded chamber pressures of P.csv, with CVODE (BDF, "
+      "Jacobian by automatic differentiation). Writes t,u1,v1,... on the input's time grid "
+      "(--out); where P.csv also holds measured angles, prints the error table (mean, median "
+      "and max absolute error per angle, rad). Then prints the real-time factor (simulated "
+      "seconds per wall-clock second) and the solver's counters.",
       "  softrne-sim --robot examples/data/arm-a-1/robot.json \\\n"
-      "              --pressures examples/data/arm-a-1/test.csv --out sim.csv\n\n" +
-      softrne::cli::ArgParser::exit_code_text());
-  if (!args.parse(argc, argv)) return softrne::cli::kExitOk;
-  softrne::cli::check_outputs_are_not_inputs(args, {"robot", "pressures"}, {"out"});
-
-  const std::string robot_path = args.value("robot");
-  const std::string data_path = args.value("pressures");
-  const std::string out_path = args.value("out");
-  const bool quiet = args.has("quiet");
+      "              --pressures examples/data/arm-a-1/test.csv --out sim.csv");
+  std::string robot_path, data_path, out_path;
+  app.add_option("--robot", robot_path, "robot description (softrne-robot/1)")
+      ->type_name("R.json")
+      ->required();
+  app.add_option("--pressures", data_path,
+                 "recorded pressures: t,p1_0,...; angles u1,v1,... optional")
+      ->type_name("P.csv")
+      ->required();
+  app.add_option("--out", out_path,
+                 "write the simulated angles here ('-' = stdout; the report then goes to stderr)")
+      ->type_name("S.csv");
   softrne::sim::ArmSimulationOptions opt;
-  opt.cvode.rtol = args.number("rtol", def_rtol, 0.0, 1.0, true);
-  opt.cvode.atol = args.number("atol", def_atol, 0.0, HUGE_VAL, true);
-  if (args.has("atol-velocity"))
-    opt.velocity_atol_factor =
-        args.number("atol-velocity", 0.0, 0.0, HUGE_VAL, true) / opt.cvode.atol;
-  const std::string mode = args.choice("interpolation", {"pchip", "linear", "zoh"}, "pchip");
+  app.add_option("--rtol", opt.cvode.rtol, "relative tolerance of the integrator")
+      ->type_name("X")
+      ->capture_default_str()
+      ->check(FiniteNumber(0, 1, FiniteNumber::open));
+  app.add_option("--atol", opt.cvode.atol,
+                 "absolute tolerance of the angles (rad); well below the angle sensors' noise")
+      ->type_name("X")
+      ->capture_default_str()
+      ->check(FiniteNumber(0, HUGE_VAL, FiniteNumber::open));
+  double atol_velocity = 0;
+  const CLI::Option* atol_velocity_opt =
+      app.add_option("--atol-velocity", atol_velocity,
+                     "absolute tolerance of the angular velocities (rad/s)")
+          ->type_name("X")
+          ->default_str(softrne::io::detail::format_double(opt.velocity_atol_factor) + " x atol")
+          ->check(FiniteNumber(0, HUGE_VAL, FiniteNumber::open));
+  std::string mode = "pchip";
+  app.add_option("--interpolation", mode,
+                 "recorded pressures between samples: pchip (C1, no overshoot), linear, zoh")
+      ->type_name("MODE")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"pchip", "linear", "zoh"}));
+  app.add_option(
+         "--smooth", opt.pressure_smoothing,
+         "OPTIONAL pre-smoothing of the recorded pressures by a Gaussian kernel of standard "
+         "deviation SIGMA seconds (zero phase). Changes the model's input: removes sensor "
+         "noise the integrator would otherwise resolve (faster), rounds off steps")
+      ->type_name("SIGMA")
+      ->default_str("off")
+      ->check(FiniteNumber(0));
+  std::string jac = "ad";
+  app.add_option(
+         "--jacobian", jac,
+         "Jacobian for the integrator's Newton iteration: ad (AutoDiff through inverse "
+         "dynamics), ad-forward (AutoDiff through forward dynamics), fd (CVODE's differences)")
+      ->type_name("METHOD")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"ad", "ad-forward", "fd"}));
+  long max_steps = 0;
+  app.add_option("--max-steps", max_steps, "integrator step limit")
+      ->type_name("N")
+      ->default_str("max(1e5, 1e4 per s)")
+      ->transform(softrne::cli::DecimalInteger)
+      ->check(CLI::Range(1L, 1000000000L));
+  bool quiet = false;
+  app.add_flag("--quiet", quiet,
+               "no progress indicator (shown on a terminal for runs over a second) and no solver "
+               "statistics; the error table stays");
+  if (!app.parse_command_line(argc, argv)) return softrne::cli::kExitOk;
+  softrne::cli::check_outputs_are_not_inputs({{"--robot", robot_path}, {"--pressures", data_path}},
+                                             {{"--out", out_path}});
+
+  if (atol_velocity_opt->count()) opt.velocity_atol_factor = atol_velocity / opt.cvode.atol;
   opt.interpolation = mode == "pchip"    ? PI::pchip
                       : mode == "linear" ? PI::linear
                                          : PI::zero_order_hold;
-  opt.pressure_smoothing = args.number("smooth", 0.0, 0.0, HUGE_VAL);
-  const std::string jac = args.choice("jacobian", {"ad", "ad-forward", "fd"}, "ad");
   opt.autodiff_jacobian = jac != "fd";
   opt.jacobian_method = jac == "ad-forward"
                             ? softrne::sim::ArmSimulationOptions::JacobianMethod::forward_dynamics
                             : softrne::sim::ArmSimulationOptions::JacobianMethod::inverse_dynamics;
-  const long max_steps_arg = args.integer("max-steps", 0, 1, 1000000000L);
 
   // Inputs: every problem is an io::InputError naming the file.
   const softrne::io::RobotSpec robot = softrne::io::read_robot_json(robot_path);
@@ -148,7 +160,7 @@ int run_sim(int argc, char** argv) {
   Eigen::VectorXd q0 = Eigen::VectorXd::Zero(desc.nq);
   if (data.has_angles) q0 = data.angles.row(0).transpose();
   opt.cvode.max_steps =
-      max_steps_arg > 0 ? max_steps_arg : std::max(100000L, static_cast<long>(1e4 * (t1 - t0)));
+      max_steps > 0 ? max_steps : std::max(100000L, static_cast<long>(1e4 * (t1 - t0)));
 
   Progress progress(!quiet && softrne::cli::stderr_is_terminal(), t0, t1);
   opt.progress = [&](double t) { progress.update(t); };

@@ -1,18 +1,21 @@
 #pragma once
 /// \file
-/// \brief What every softrne command-line tool shares (shared/spec/formats.md section 6):
-/// option parsing with `--help`, one-line error messages `<tool>: <file>: <where>: <what>`,
-/// and the exit codes.
+/// \brief What every softrne command-line tool shares (docs/formats.md section 6): the exit
+/// codes, one-line error messages `<tool>: <file>: <where>: <what>`, Ctrl-C, and the command
+/// line: parsed by CLI11, adapted here to those rules (cli::App).
 ///
 /// Usage:
 /// \code
 ///   int main(int argc, char** argv) {
 ///     return softrne::cli::run("softrne-x", [&] {
-///       softrne::cli::ArgParser args("softrne-x", "--in F [--out G]", "What it does.");
-///       args.option("in", "F", "input file").required();
-///       args.flag("quiet", "print nothing but errors");
-///       if (!args.parse(argc, argv)) return softrne::cli::kExitOk;  // --help was printed
-///       const std::string in = args.value("in");
+///       softrne::cli::App app("softrne-x", "--in F [--threads N]", "What it does.");
+///       std::string in;
+///       int threads = 2;
+///       app.add_option("--in", in, "input file")->type_name("F")->required();
+///       app.add_option("--threads", threads, "parallel jobs")->type_name("N")
+///           ->capture_default_str()->transform(softrne::cli::DecimalInteger)->check(CLI::Range(1,
+///           64));
+///       if (!app.parse_command_line(argc, argv)) return softrne::cli::kExitOk;  // --help
 ///       ...
 ///       return softrne::cli::kExitOk;
 ///     });
@@ -24,20 +27,20 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
-#include <filesystem>
-#include <functional>
 #include <iostream>
-#include <limits>
+#include <memory>
 #include <new>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <CLI/CLI.hpp>
 
 #include "softrne/io/errors.hpp"
 
@@ -86,7 +89,8 @@ inline void stop_on_interrupt() {
 /// \brief Throws Interrupted if Ctrl-C was pressed: call after a long computation, before
 /// writing its results (which may be incomplete).
 inline void throw_if_interrupted(const std::string& what) {
-  if (interrupted.load()) throw Interrupted("interrupted (Ctrl-C) during " + what + ": nothing written");
+  if (interrupted.load())
+    throw Interrupted("interrupted (Ctrl-C) during " + what + ": nothing written");
 }
 
 /// \brief A bad command line; `what()` is the message after `<tool>: `.
@@ -165,269 +169,155 @@ inline bool stderr_is_terminal() {
 #endif
 }
 
-/// \brief Long options `--name value`, `--name=value` and flags `--name`, plus `--help`/`-h`.
-/// Unknown options, positional arguments, a missing value and an option given twice are
-/// UsageErrors.
-class ArgParser {
+/// \brief The exit codes and the error format, for the end of every tool's --help.
+inline const std::string kExitStatusText =
+    "exit status: 0 success; 1 the computation failed; 2 bad command line; 3 bad input file;\n"
+    "4 internal error; 130 stopped by Ctrl-C. Errors are one line on stderr:\n"
+    "  <tool>: <file>: <where>: <what>";
+
+/// \brief For integer options, before CLI11 converts: decimal digits only (an optional sign),
+/// leading zeros dropped. CLI11 2.1 reads integers with strtoll(..., 0), so "010" would be 8
+/// and "0x10" 16, and reports "1.5" as out of range; here they are "not an integer".
+inline const CLI::Validator DecimalInteger(
+    [](std::string& s) {
+      const std::size_t digits = !s.empty() && (s[0] == '-' || s[0] == '+') ? 1 : 0;
+      if (s.size() == digits || s.find_first_not_of("0123456789", digits) != std::string::npos)
+        return "not an integer: " + io::detail::quoted(s);
+      const std::size_t lead = std::min(s.find_first_not_of('0', digits), s.size() - 1);
+      s = (s[0] == '-' && s[lead] != '0' ? "-" : "") + s.substr(lead);
+      return std::string();
+    },
+    "", "INTEGER");
+
+/// \brief A finite number in [lo, hi], or (lo, hi] with FiniteNumber::open. (CLI::Range and
+/// CLI::PositiveNumber accept "nan" and print their bounds with std::to_string: DBL_MAX as
+/// 309 digits.)
+class FiniteNumber : public CLI::Validator {
  public:
-  /// \param synopsis the arguments after the tool name in the usage line
-  /// \param description a paragraph printed under the usage line by --help
-  ArgParser(std::string tool, std::string synopsis, std::string description)
-      : tool_(std::move(tool)),
-        synopsis_(std::move(synopsis)),
-        description_(std::move(description)) {}
-
-  /// \brief Handle to refine the option just declared.
-  class OptionRef {
-   public:
-    OptionRef(ArgParser& p, std::size_t i) : p_(&p), i_(i) {}
-    OptionRef& required() {
-      p_->opts_[i_].required = true;
-      return *this;
-    }
-    OptionRef& default_value(std::string v) {
-      p_->opts_[i_].default_text = std::move(v);
-      return *this;
-    }
-
-   private:
-    ArgParser* p_;
-    std::size_t i_;
-  };
-
-  /// \brief An option with a value, `--name VALUE`.
-  OptionRef option(const std::string& name, const std::string& value_name,
-                   const std::string& help) {
-    opts_.push_back(Option{name, value_name, help, false, false, "", false, ""});
-    return OptionRef(*this, opts_.size() - 1);
-  }
-  /// \brief A flag without a value, `--name`.
-  OptionRef flag(const std::string& name, const std::string& help) {
-    opts_.push_back(Option{name, "", help, true, false, "", false, ""});
-    return OptionRef(*this, opts_.size() - 1);
-  }
-  /// \brief A paragraph appended to --help (examples, exit codes).
-  void epilog(std::string text) { epilog_ = std::move(text); }
-
-  /// \brief Parses argv. \return false if --help was asked for (the help is then printed on
-  /// stdout and the tool should exit 0). Throws UsageError.
-  bool parse(int argc, char** argv) {
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i] ? argv[i] : "";
-      if (a == "--help" || a == "-h") {
-        std::cout << help();
-        return false;
-      }
-    }
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i] ? argv[i] : "";
-      if (a.size() < 3 || a.compare(0, 2, "--") != 0) {
-        if (!a.empty() && a[0] == '-' && a != "-")
-          throw UsageError("unknown option " + io::detail::quoted(a));
-        throw UsageError("unexpected argument " + io::detail::quoted(a) +
-                         " (options are given as --name value)");
-      }
-      std::string name = a.substr(2), value;
-      bool has_inline_value = false;
-      if (const auto eq = name.find('='); eq != std::string::npos) {
-        value = name.substr(eq + 1);
-        name = name.substr(0, eq);
-        has_inline_value = true;
-      }
-      Option* o = find(name);
-      if (!o)
-        throw UsageError("unknown option " + io::detail::quoted("--" + name) + suggestion(name));
-      if (o->seen) throw UsageError("option --" + name + " given twice");
-      o->seen = true;
-      if (o->is_flag) {
-        if (has_inline_value) throw UsageError("option --" + name + " takes no value");
-        continue;
-      }
-      if (!has_inline_value) {
-        if (i + 1 >= argc)
-          throw UsageError("option --" + name + " needs a value (" + o->value_name + ")");
-        value = argv[++i] ? argv[i] : "";
-      }
-      if (value.empty()) throw UsageError("option --" + name + ": empty value");
-      o->value = value;
-    }
-    for (const auto& o : opts_)
-      if (o.required && !o.seen)
-        throw UsageError("missing required option --" + o.name + " " + o.value_name);
-    return true;
-  }
-
-  /// \brief True if the option or flag was given.
-  bool has(const std::string& name) const { return get(name).seen; }
-  /// \brief The option's value, or its default text ("" if none) when it was not given.
-  std::string value(const std::string& name) const {
-    const Option& o = get(name);
-    return o.seen ? o.value : o.default_text;
-  }
-  /// \brief The option's value as a finite number in [lo, hi]; `fallback` if not given.
-  double number(const std::string& name, double fallback, double lo = -HUGE_VAL,
-                double hi = HUGE_VAL, bool lo_open = false) const {
-    const Option& o = get(name);
-    if (!o.seen) return fallback;
-    const std::string& s = o.value;
-    errno = 0;
-    char* end = nullptr;
-    const double v = std::strtod(s.c_str(), &end);
-    if (end == s.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
-      throw UsageError("option --" + name + ": not a finite number: " + io::detail::quoted(s));
-    if (v < lo || v > hi || (lo_open && v == lo)) {
-      std::string range =
-          lo_open ? "> " + io::detail::format_double(lo) : ">= " + io::detail::format_double(lo);
-      if (lo == -HUGE_VAL)
-        range = "<= " + io::detail::format_double(hi);
-      else if (hi != HUGE_VAL)
-        range += " and <= " + io::detail::format_double(hi);
-      throw UsageError("option --" + name + ": must be " + range + " (got " + s + ")");
-    }
-    return v;
-  }
-  /// \brief The option's value as an integer in [lo, hi]; `fallback` if not given.
-  long integer(const std::string& name, long fallback, long lo, long hi) const {
-    const Option& o = get(name);
-    if (!o.seen) return fallback;
-    errno = 0;
-    char* end = nullptr;
-    const long v = std::strtol(o.value.c_str(), &end, 10);
-    if (end == o.value.c_str() || *end != '\0' || errno == ERANGE)
-      throw UsageError("option --" + name + ": not an integer: " + io::detail::quoted(o.value));
-    if (v < lo || v > hi)
-      throw UsageError("option --" + name + ": must be in [" + std::to_string(lo) + ", " +
-                       std::to_string(hi) + "] (got " + o.value + ")");
-    return v;
-  }
-  /// \brief The option's value, which must be one of `choices`; `fallback` if not given.
-  std::string choice(const std::string& name, const std::vector<std::string>& choices,
-                     const std::string& fallback) const {
-    const Option& o = get(name);
-    if (!o.seen) return fallback;
-    for (const auto& c : choices)
-      if (c == o.value) return c;
-    std::string list;
-    for (const auto& c : choices) list += (list.empty() ? "" : ", ") + c;
-    throw UsageError("option --" + name + ": unknown value " + io::detail::quoted(o.value) +
-                     " (one of " + list + ")");
-  }
-
-  /// \brief The --help text (option descriptions wrapped at 100 columns).
-  std::string help() const {
-    std::string s = "usage: " + tool_ + " " + synopsis_ + "\n\n" + description_ + "\n\noptions:\n";
-    std::size_t width = 10;
-    auto left = [](const Option& o) {
-      return "--" + o.name + (o.is_flag ? std::string() : " " + o.value_name);
+  enum Lower { closed, open };
+  explicit FiniteNumber(double lo, double hi = HUGE_VAL, Lower lower = closed) {
+    std::string range = (lower == open ? "> " : ">= ") + io::detail::format_double(lo);
+    if (hi != HUGE_VAL) range += " and <= " + io::detail::format_double(hi);
+    description(range);
+    func_ = [=](std::string& s) {
+      char* end = nullptr;
+      const double v = std::strtod(s.c_str(), &end);
+      if (s.empty() || *end != '\0' || !std::isfinite(v))
+        return "not a finite number: " + io::detail::quoted(s);
+      if (v < lo || v > hi || (lower == open && v == lo))
+        return "must be " + range + " (got " + s + ")";
+      return std::string();
     };
-    for (const auto& o : opts_) width = std::max(width, left(o).size());
-    auto add = [&](const std::string& l, const std::string& text) {
-      std::string line = "  " + l;
-      line.resize(width + 4, ' ');
-      s += wrap(line, text, width + 4, 100);
-    };
-    for (const auto& o : opts_) {
-      std::string text = o.help;
-      if (o.required) text += " (required)";
-      if (!o.default_text.empty()) text += " [default: " + o.default_text + "]";
-      add(left(o), text);
-    }
-    add("--help", "print this help and exit");
-    if (!epilog_.empty()) s += "\n" + epilog_ + "\n";
-    return s;
   }
+};
 
-  /// \brief Standard paragraph on exit codes and error messages, for epilogs.
-  static std::string exit_code_text() {
-    return "exit status: 0 success; 1 the computation failed; 2 bad command line; 3 bad input\n"
-           "file; 4 internal error. Errors are one line on stderr:\n"
-           "  <tool>: <file>: <where>: <what>";
+/// \brief --help in the tools' layout, wrapped at 100 columns: the usage line first, the
+/// description; each option as `--name VALUE` and its description, followed by what CLI11
+/// knows of it in parentheses (its validators' descriptions, "required", its default); the
+/// footer (examples, exit status) last.
+class HelpFormatter : public CLI::Formatter {
+ public:
+  explicit HelpFormatter(std::string synopsis) : synopsis_(std::move(synopsis)) {}
+  std::string make_usage(const CLI::App*, std::string name) const override {
+    return "usage: " + name + " " + synopsis_ + "\n";
+  }
+  std::string make_help(const CLI::App* app, std::string name,
+                        CLI::AppFormatMode mode) const override {
+    if (mode == CLI::AppFormatMode::Sub) return CLI::Formatter::make_help(app, name, mode);
+    return make_usage(app, name) + "\n" + wrap(app->get_description(), 100) + "\n" +
+           make_groups(app, mode) + make_subcommands(app, mode) + "\n" + make_footer(app);
+  }
+  // CLI11 writes `VALUE:validators=default REQUIRED` after the name; only VALUE stays there.
+  std::string make_option_opts(const CLI::Option* opt) const override {
+    return opt->get_type_size() == 0 ? "" : " " + value_name(opt).first;
+  }
+  std::string make_option_desc(const CLI::Option* opt) const override {
+    std::string notes = opt->get_type_size() == 0 ? "" : value_name(opt).second;
+    if (opt->get_required()) notes += (notes.empty() ? "" : "; ") + std::string("required");
+    if (!opt->get_default_str().empty())
+      notes += (notes.empty() ? "" : "; ") + ("default " + opt->get_default_str());
+    return wrap(opt->get_description() + (notes.empty() ? "" : " (" + notes + ")"),
+                100 - get_column_width());
   }
 
  private:
-  struct Option {
-    std::string name, value_name, help;
-    bool is_flag = false;
-    bool required = false;
-    std::string default_text;
-    bool seen = false;
-    std::string value;
-  };
-
-  Option* find(const std::string& name) {
-    for (auto& o : opts_)
-      if (o.name == name) return &o;
-    return nullptr;
-  }
-  const Option& get(const std::string& name) const {
-    for (const auto& o : opts_)
-      if (o.name == name) return o;
-    throw std::logic_error("ArgParser: option --" + name + " was not declared");
-  }
-  std::string suggestion(const std::string& name) const {
-    std::string best;
-    std::size_t best_d = 3;
-    for (const auto& o : opts_) {
-      const std::size_t d = edit_distance(name, o.name);
-      if (d < best_d) best_d = d, best = o.name;
+  /// `text` with its words on lines of at most `width` characters.
+  static std::string wrap(const std::string& text, std::size_t width) {
+    std::string out, line;
+    std::istringstream words(text);
+    for (std::string w; words >> w;) {
+      if (!line.empty() && line.size() + 1 + w.size() > width) out += line + "\n", line.clear();
+      line += (line.empty() ? "" : " ") + w;
     }
-    return best.empty() ? std::string() : "; did you mean --" + best + "?";
+    return out + line;
   }
-  static std::size_t edit_distance(const std::string& a, const std::string& b) {
-    std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-      cur[0] = i;
-      for (std::size_t j = 1; j <= b.size(); ++j)
-        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
-      std::swap(prev, cur);
-    }
-    return prev[b.size()];
+  /// CLI11's type name "VALUE:validator:validator" split into "VALUE" and "validator; validator".
+  static std::pair<std::string, std::string> value_name(const CLI::Option* opt) {
+    const std::string t = opt->get_type_name();
+    const std::size_t colon = std::min(t.find(':'), t.size());
+    std::string rest = colon < t.size() ? t.substr(colon + 1) : "";
+    for (std::size_t i = rest.find(':'); i != std::string::npos; i = rest.find(':', i))
+      rest.replace(i, 1, "; ");
+    return {t.substr(0, colon), rest};
   }
-
-  /// `first` (already `indent` wide) followed by `text` wrapped at `columns`, continuation
-  /// lines indented by `indent`.
-  static std::string wrap(std::string first, const std::string& text, std::size_t indent,
-                          std::size_t columns) {
-    std::string out, line = std::move(first);
-    std::size_t pos = 0;
-    bool line_empty = true;
-    while (pos < text.size()) {
-      const std::size_t end = std::min(text.find(' ', pos), text.size());
-      const std::string word = text.substr(pos, end - pos);
-      pos = end + 1;
-      if (word.empty()) continue;
-      if (!line_empty && line.size() + 1 + word.size() > columns) {
-        out += line + "\n";
-        line = std::string(indent, ' ');
-        line_empty = true;
-      }
-      line += (line_empty ? "" : " ") + word;
-      line_empty = false;
-    }
-    return out + line + "\n";
-  }
-
-  std::string tool_, synopsis_, description_, epilog_;
-  std::vector<Option> opts_;
+  std::string synopsis_;
 };
 
-/// \brief Refuses (UsageError) an output option that names one of the input files: a tool
-/// never overwrites what it reads. Files are compared as files (std::filesystem::equivalent:
-/// `./run.csv`, `run.csv` and a link to it are the same). Options not given are skipped.
-inline void check_outputs_are_not_inputs(const ArgParser& args, const std::vector<std::string>& inputs,
-                                         const std::vector<std::string>& outputs) {
-  namespace fs = std::filesystem;
-  for (const auto& out : outputs) {
-    if (!args.has(out) || args.value(out) == "-") continue;
-    for (const auto& in : inputs) {
-      if (!args.has(in)) continue;
-      std::error_code ec;
-      if (fs::equivalent(fs::path(args.value(out)), fs::path(args.value(in)), ec) && !ec)
-        throw UsageError("option --" + out + ": " + args.value(out) + " is the input given to --" + in +
-                         "; refusing to overwrite an input");
-    }
+/// \brief A tool's command line: CLI11's App with the tools' --help layout (HelpFormatter), the
+/// exit status in its footer, and parse_command_line(), which maps CLI11's errors to UsageError.
+class App : public CLI::App {
+ public:
+  /// \param synopsis the arguments after the tool name in the usage line
+  /// \param description a paragraph printed under the usage line by --help
+  /// \param example lines printed under "example:" at the end of --help
+  App(const std::string& tool, std::string synopsis, const std::string& description,
+      const std::string& example = "")
+      : CLI::App(description, tool) {
+    formatter(std::make_shared<HelpFormatter>(std::move(synopsis)));
+    footer((example.empty() ? "" : "example:\n" + example + "\n\n") + kExitStatusText);
+    // --help acts where it is read, before the other options are checked: the help is shown
+    // whatever else is wrong on the command line.
+    set_help_flag();
+    add_flag_callback(
+        "-h,--help", [] { throw CLI::CallForHelp(); }, "print this help and exit")
+        ->trigger_on_parse();
   }
-}
+
+  /// \brief Parses argv. \return false if the tool is done and exits 0: --help was asked for
+  /// (the help is then printed on stdout) or an option's callback threw CLI::Success. Every
+  /// other problem is a UsageError with CLI11's one-line message, which names the option, or
+  /// "unexpected argument(s): ..." if any argument is not an option of the tool (reported
+  /// first: a misspelt --robot is also a missing --robot). An option with a value given twice
+  /// is an error (CLI11's default), a flag given twice counts once; an empty value is an error.
+  bool parse_command_line(int argc, char** argv) {
+    try {
+      parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+      std::cout << help();
+      return false;
+    } catch (const CLI::Success&) {
+      return false;
+    } catch (const CLI::ParseError& e) {
+      const std::vector<std::string> extra = remaining();
+      if (extra.empty()) throw UsageError(e.what());
+      // CLI11 2.1's own message (ExtrasError) lists the arguments backwards.
+      std::string args;
+      for (const std::string& a : extra) args += " " + io::detail::quoted(a);
+      throw UsageError((extra.size() > 1 ? "unexpected arguments:" : "unexpected argument:") +
+                       args);
+    }
+    reject_empty_values(*this);
+    return true;
+  }
+
+ private:
+  static void reject_empty_values(const CLI::App& app) {
+    for (const CLI::Option* o : app.get_options())
+      for (const std::string& r : o->results())
+        if (r.empty()) throw UsageError(o->get_name() + ": empty value");
+    for (const CLI::App* group : app.get_subcommands([](const CLI::App*) { return true; }))
+      reject_empty_values(*group);
+  }
+};
 
 }  // namespace softrne::cli
