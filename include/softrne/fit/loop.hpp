@@ -438,6 +438,10 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       const double mean = sum / static_cast<double>(gains.size());
       std::string line = "  " + s.label + ": held-out error";
       for (double g : gains) line += " " + detail::percent(g);
+      std::string unconverged;
+      for (std::size_t f = 0; f < trials.size(); ++f)
+        if (!trials[f].fit.fit.converged) unconverged += (unconverged.empty() ? "" : ", ") + std::to_string(f + 1);
+      if (!unconverged.empty()) line += " (refit budget spent in fold " + unconverged + ")";
       if (s.confirmed && !(mean > s.cv_gain)) {
         log(line + " (the earlier refit is kept)");
         return;
@@ -530,7 +534,6 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       for (std::size_t r = 0; r < scores.size(); ++r) {
         const AnyEffect& o = cands[score_cand[r]].effect;
         if (scores[r].name != scores[narrow].name || effect_base(o).scope != Scope::Shared) continue;
-        if (scores[r].confirmed) break;  // refitted already (this round)
         confirm_beside(narrow, r, "the shared scope of",
                        [](const AnyEffect& fitted, const Eigen::VectorXd& screen_start) {
                          const Eigen::VectorXd& p = effect_base(fitted).params;
