@@ -20,12 +20,15 @@ int main(int argc, char** argv) {
     args.option("data", "train.csv", "pressures and measured angles").required();
     args.option("out", "fitted.json", "where to write the fitted robot").required();
     args.option("test", "test.csv", "a held-out data set: only measured, never fitted");
+    args.option("report", "R.json",
+                "also write the fit report here (softrne-fit-report/1: parameters, standard errors, "
+                "error statistics, fitted robot)");
     args.flag("pressure-gain", "also fit one gain on K_prs per CC joint");
     args.option("seed", "N", "optimiser seed (default 1)");
     args.option("threads", "N", "parallel simulations (default 2)");
     args.flag("quiet", "no progress line");
     if (!args.parse(argc, argv)) return cli::kExitOk;
-    cli::check_outputs_are_not_inputs(args, {"robot", "data", "test"}, {"out"});
+    cli::check_outputs_are_not_inputs(args, {"robot", "data", "test"}, {"out", "report"});
     const io::RobotSpec spec = io::read_robot_json(args.value("robot"));
     const io::Dataset train = io::read_dataset(args.value("data"), spec, true);
     io::Dataset test;
@@ -48,34 +51,23 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "\rsoftrne-fit: %d simulations, best rms error %.5f rad   ", evals,
                      std::sqrt(2 * cost / nq));
       };
-    auto before = [&](const io::Dataset& d) {
-      const auto s = fit::simulate_dataset(desc, d, opt.simulation);
-      if (!s.ok()) throw cli::Failure(d.source + ": the starting model fails to simulate: " + s.result.message);
-      return error_stats(s.angles, d.angles, desc.coordinate_names);
-    };
-    const ErrorStats train_before = before(train);
-    fit::ArmFitResult r;
     cli::stop_on_interrupt();
     opt.simulation.cvode.stop = &cli::interrupted;
-    try {
-      r = fit::fit_arm(desc, train, opt);
-    } catch (const std::invalid_argument& e) {
-      throw cli::Failure(e.what());
-    }
+    const cli::FitRun run = cli::run_fit(desc, train, has_test ? &test : nullptr, opt);
     cli::throw_if_interrupted("the fit");
     if (!quiet) std::fprintf(stderr, "\n");
-    if (!std::isfinite(r.fit.cost)) throw cli::Failure(train.source + ": the fit found no parameters that simulate: " + r.fit.message);
+    const fit::ArmFitResult& r = run.result;
     io::write_robot_json(to_robot_spec(r.fitted), args.value("out"));
+    if (args.has("report"))
+      io::detail::write_text_file(args.value("report"), cli::fit_report_json(run).dump(2) + "\n");
     std::printf("fitted %d parameters in %.1f s (%d simulations)\n", r.parameters.size(), r.wall_seconds, r.simulations);
     std::printf("%s", cli::parameter_table(r).c_str());
     if (!r.fit.identifiability_report.empty()) std::printf("identifiability:\n%s\n", r.fit.identifiability_report.c_str());
-    std::printf("%s", format_error_table(train_before, "train, before (" + train.source + ")").c_str());
+    std::printf("%s", format_error_table(run.train_before, "train, before (" + train.source + ")").c_str());
     std::printf("%s", format_error_table(r.stats, "train, after").c_str());
     if (has_test) {
-      std::printf("%s", format_error_table(before(test), "test, before (" + test.source + ")").c_str());
-      const auto s = fit::simulate_dataset(r.fitted, test, opt.simulation);
-      if (!s.ok()) throw cli::Failure(test.source + ": the fitted model fails to simulate: " + s.result.message);
-      std::printf("%s", format_error_table(error_stats(s.angles, test.angles, r.fitted.coordinate_names), "test, after").c_str());
+      std::printf("%s", format_error_table(run.test_before, "test, before (" + test.source + ")").c_str());
+      std::printf("%s", format_error_table(run.test_after, "test, after").c_str());
     }
     std::printf("wrote %s\n", args.value("out").c_str());
     return cli::kExitOk;
