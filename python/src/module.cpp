@@ -444,7 +444,7 @@ NB_MODULE(_softrne, m) {
           },
           "Names of the bodies of the chain, base to tip (a payload effect adds one named 'payload'); "
           "one frame each in frames().")
-      .def_prop_ro("gravity", [](const Robot& r) { return vector_out(r.chain.gravity); }, nb::rv_policy::move,
+      .def_prop_ro("gravity_vector", [](const Robot& r) { return vector_out(r.chain.gravity); }, nb::rv_policy::move,
                    "Gravitational acceleration in the base frame (m/s^2).")
       .def("__repr__", [](const Robot& r) {
         return "softrne.Robot('" + r.desc.spec.name + "', nq=" + std::to_string(r.nq()) + ", segments=" +
@@ -479,29 +479,32 @@ NB_MODULE(_softrne, m) {
       "q"_a, "threads"_a = 0,
       (std::string("The joint-space mass matrix M(q), shape (nq, nq) (symmetric, positive definite).") + kThreadsDoc).c_str());
   robot.def(
-      "gravity_forces",
+      "gravity",
       [](Robot& r, nb::handle q, int threads) {
-        const States s = states(r, "gravity_forces", {{"q", q}});
+        const States s = states(r, "gravity", {{"q", q}});
         const int nq = r.nq();
         return evaluate(r, s, {static_cast<size_t>(nq)}, threads, [nq, &r](Data& d, const double* const* in, double* out) {
           Vec(out, nq) = softrne::gravity(r.chain, d, CVec(in[0], nq));
         });
       },
       "q"_a, "threads"_a = 0,
-      (std::string("The gravity forces G(q) = rnea(q, 0, 0). (The robot's gravity vector is the property `gravity`.)") +
+      (std::string("The gravity forces G(q) = rnea(q, 0, 0) (the gravitational acceleration itself is "
+                   "gravity_vector).") +
        kThreadsDoc)
           .c_str());
   robot.def(
       "bias",
-      [](Robot& r, nb::handle q, nb::handle qd, int threads) {
+      [](Robot& r, nb::handle q, nb::handle qd, bool with_gravity, int threads) {
         const States s = states(r, "bias", {{"q", q}, {"qd", qd}});
         const int nq = r.nq();
-        return evaluate(r, s, {static_cast<size_t>(nq)}, threads, [nq, &r](Data& d, const double* const* in, double* out) {
-          Vec(out, nq) = softrne::bias(r.chain, d, CVec(in[0], nq), CVec(in[1], nq));
-        });
+        return evaluate(r, s, {static_cast<size_t>(nq)}, threads,
+                        [nq, &r, with_gravity](Data& d, const double* const* in, double* out) {
+                          Vec(out, nq) = softrne::bias(r.chain, d, CVec(in[0], nq), CVec(in[1], nq), with_gravity);
+                        });
       },
-      "q"_a, "qd"_a, "threads"_a = 0,
-      (std::string("The Coriolis and centrifugal forces C(q, qd) qd (gravity excluded) = rnea(q, qd, 0) - G(q).") +
+      "q"_a, "qd"_a, "with_gravity"_a = false, "threads"_a = 0,
+      (std::string("The velocity-product forces C(q, qd) qd = rnea(q, qd, 0) - G(q); with_gravity: "
+                   "C(q, qd) qd + G(q) in one pass.") +
        kThreadsDoc)
           .c_str());
   robot.def(
