@@ -18,10 +18,14 @@
 #include <vector>
 
 #include <nanobind/nanobind.h>
-#include <nanobind/ndarray.h>
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
+
+// numpy's C API: arguments read and results made in a few ns (nanobind's ndarray import and
+// export cost about 0.2 and 0.6 us each, more than the dynamics of a small arm).
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
 
 #include "common/report.hpp"
 #include "softrne/fit/arm_fit.hpp"
@@ -40,8 +44,7 @@ namespace {
 
 using Chain = softrne::DynamicChain<double>;
 using Data = softrne::DynamicChainData<double>;
-using Array = nb::ndarray<const double, nb::c_contig, nb::device::cpu>;
-using OutArray = nb::ndarray<nb::numpy, double>;
+using OutArray = nb::object;  ///< a numpy array of float64 made here
 using CVec = Eigen::Map<const Eigen::VectorXd>;
 using Vec = Eigen::Map<Eigen::VectorXd>;
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -70,28 +73,46 @@ struct Robot {
   }
 };
 
+/// \brief An argument as a C-contiguous float64 numpy array: the argument itself where it is
+/// one (read through the numpy C API, no copy: a few ns), else a converted copy.
+class Array {
+ public:
+  Array() = default;
+  Array(PyArrayObject* a, nb::object keep) : a_(a), keep_(std::move(keep)) {}
+  size_t ndim() const { return static_cast<size_t>(PyArray_NDIM(a_)); }
+  size_t shape(size_t i) const { return static_cast<size_t>(PyArray_DIM(a_, static_cast<int>(i))); }
+  const double* data() const { return static_cast<const double*>(PyArray_DATA(a_)); }
+
+ private:
+  PyArrayObject* a_ = nullptr;  ///< borrowed from the caller's argument, or owned by keep_
+  nb::object keep_;
+};
+
 std::string shape_text(const Array& a) {
   std::string s = "(";
   for (size_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
-/// \brief `h` as a C-contiguous float64 array (a view where it already is one).
+/// \brief `h` as a C-contiguous float64 array (the argument itself where it already is one:
+/// it stays referenced by the caller for the duration of the call).
 Array as_array(nb::handle h, const char* fn, const char* name) {
-  Array a;
-  if (h.is_none()) throw nb::value_error((std::string("softrne.") + fn + ": " + name + " is None").c_str());
-  if (nb::try_cast(h, a)) return a;
-  nb::object converted;
-  try {
-    converted = nb::module_::import_("numpy").attr("array")(h, "dtype"_a = "float64", "order"_a = "C");
-  } catch (nb::python_error& e) {
-    throw nb::value_error((std::string("softrne.") + fn + ": " + name +
-                           " is not an array of numbers (" + e.what() + ")")
+  if (h.is_none()) throw nb::type_error((std::string("softrne.") + fn + ": " + name + " is None").c_str());
+  PyObject* o = h.ptr();
+  if (PyArray_Check(o)) {
+    auto* a = reinterpret_cast<PyArrayObject*>(o);
+    if (PyArray_TYPE(a) == NPY_DOUBLE && PyArray_IS_C_CONTIGUOUS(a) && PyArray_ISALIGNED(a) &&
+        PyArray_ISNOTSWAPPED(a))
+      return Array(a, nb::object());
+  }
+  PyObject* c = PyArray_FROMANY(o, NPY_DOUBLE, 0, 0, NPY_ARRAY_IN_ARRAY);
+  if (!c) {
+    nb::python_error e;
+    throw nb::value_error((std::string("softrne.") + fn + ": " + name + " is not an array of numbers (" +
+                           e.what() + ")")
                               .c_str());
   }
-  if (!nb::try_cast(converted, a))
-    throw nb::value_error((std::string("softrne.") + fn + ": " + name + " is not an array of numbers").c_str());
-  return a;
+  return Array(reinterpret_cast<PyArrayObject*>(c), nb::steal(c));
 }
 
 /// \brief The arguments of one algorithm: each (nq,) (one state) or (N, nq) (a batch), all alike.
@@ -133,13 +154,19 @@ States states(const Robot& r, const char* fn, std::initializer_list<std::pair<co
   return s;
 }
 
-/// \brief A new numpy array of `shape` owning `n` doubles.
+/// \brief A new numpy array of float64 of `shape` (numpy C API); `out` its data.
+template <class Shape>
+OutArray new_array(const Shape& shape, double*& out) {
+  npy_intp dims[8];
+  int nd = 0;
+  for (size_t d : shape) dims[nd++] = static_cast<npy_intp>(d);
+  PyObject* a = PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
+  if (!a) throw nb::python_error();
+  out = static_cast<double*>(PyArray_DATA(reinterpret_cast<PyArrayObject*>(a)));
+  return nb::steal(a);
+}
 OutArray new_array(std::initializer_list<size_t> shape, double*& out) {
-  size_t total = 1;
-  for (size_t d : shape) total *= d;
-  out = new double[std::max<size_t>(total, 1)];
-  nb::capsule owner(out, [](void* p) noexcept { delete[] static_cast<double*>(p); });
-  return OutArray(out, shape, owner);
+  return new_array<std::initializer_list<size_t>>(shape, out);
 }
 
 int thread_count(int threads) {
@@ -162,11 +189,7 @@ OutArray evaluate(Robot& r, const States& s, std::vector<size_t> out_shape, int 
   std::vector<size_t> shape;
   if (s.batched) shape.push_back(s.n);
   shape.insert(shape.end(), out_shape.begin(), out_shape.end());
-  size_t total = 1;
-  for (size_t d : shape) total *= d;
-  out = new double[std::max<size_t>(total, 1)];
-  nb::capsule owner(out, [](void* p) noexcept { delete[] static_cast<double*>(p); });
-  OutArray result(out, shape.size(), shape.data(), owner);
+  OutArray result = new_array(shape, out);
   const double* in[3] = {nullptr, nullptr, nullptr};
   if (!s.batched) {
     for (size_t a = 0; a < nargs; ++a) in[a] = s.arrays[a].data();
@@ -361,6 +384,7 @@ struct InterruptFlag {
 }  // namespace
 
 NB_MODULE(_softrne, m) {
+  if (_import_array() < 0) throw nb::python_error();
   m.doc() =
       "softrne: dynamics of soft/rigid robot arms (constant-curvature pneumatic joints, rigid "
       "links, revolute joints) by the recursive Newton-Euler algorithm; simulation of recorded "
@@ -444,7 +468,7 @@ NB_MODULE(_softrne, m) {
           },
           "Names of the bodies of the chain, base to tip (a payload effect adds one named 'payload'); "
           "one frame each in frames().")
-      .def_prop_ro("gravity_vector", [](const Robot& r) { return vector_out(r.chain.gravity); }, nb::rv_policy::move,
+      .def_prop_ro("gravity_vector", [](const Robot& r) { return vector_out(r.chain.gravity); }, 
                    "Gravitational acceleration in the base frame (m/s^2).")
       .def("__repr__", [](const Robot& r) {
         return "softrne.Robot('" + r.desc.spec.name + "', nq=" + std::to_string(r.nq()) + ", segments=" +
@@ -573,14 +597,14 @@ NB_MODULE(_softrne, m) {
           },
           "robot"_a, "t"_a, "pressures"_a, "angles"_a = nb::none(), "source"_a = "<arrays>",
           "A data set for `robot` from arrays: t (N,), pressures (N, num_pressures), angles (N, nq) or None.")
-      .def_prop_ro("t", [](const softrne::io::Dataset& d) { return vector_out(d.t); }, nb::rv_policy::move, "Sample times (s), shape (N,).")
-      .def_prop_ro("pressures", [](const softrne::io::Dataset& d) { return matrix_out(d.pressures); }, nb::rv_policy::move,
+      .def_prop_ro("t", [](const softrne::io::Dataset& d) { return vector_out(d.t); },  "Sample times (s), shape (N,).")
+      .def_prop_ro("pressures", [](const softrne::io::Dataset& d) { return matrix_out(d.pressures); }, 
                    "Chamber pressures (Pa), shape (N, num_pressures).")
       .def_prop_ro(
           "angles",
           [](const softrne::io::Dataset& d) -> nb::object {
             if (!d.has_angles) return nb::none();
-            return nb::cast(matrix_out(d.angles));
+            return matrix_out(d.angles);
           },
           "Measured angles (rad), shape (N, nq), or None.")
       .def_ro("has_angles", &softrne::io::Dataset::has_angles)
