@@ -44,7 +44,6 @@ namespace {
 
 using Chain = softrne::DynamicChain<double>;
 using Data = softrne::DynamicChainData<double>;
-using OutArray = nb::object;  ///< a numpy array of float64 made here
 using CVec = Eigen::Map<const Eigen::VectorXd>;
 using Vec = Eigen::Map<Eigen::VectorXd>;
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -72,6 +71,20 @@ struct Robot {
     }
   }
 };
+
+bool any_object(PyObject*) { return true; }
+bool is_ndarray(PyObject* o) { return PyArray_Check(o); }
+
+/// \brief An array argument: anything numpy can read as an array of numbers (the name is
+/// what the signatures and the stubs show).
+class ArrayLike : public nb::object {
+  NB_OBJECT_DEFAULT(ArrayLike, nb::object, "numpy.typing.ArrayLike", any_object)
+};
+/// \brief A result: a new numpy array of float64.
+class NDArray : public nb::object {
+  NB_OBJECT_DEFAULT(NDArray, nb::object, "numpy.typing.NDArray[numpy.float64]", is_ndarray)
+};
+using OutArray = NDArray;
 
 /// \brief An argument as a C-contiguous float64 numpy array: the argument itself where it is
 /// one (read through the numpy C API, no copy: a few ns), else a converted copy.
@@ -163,7 +176,7 @@ OutArray new_array(const Shape& shape, double*& out) {
   PyObject* a = PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
   if (!a) throw nb::python_error();
   out = static_cast<double*>(PyArray_DATA(reinterpret_cast<PyArrayObject*>(a)));
-  return nb::steal(a);
+  return nb::steal<NDArray>(a);
 }
 OutArray new_array(std::initializer_list<size_t> shape, double*& out) {
   return new_array<std::initializer_list<size_t>>(shape, out);
@@ -285,7 +298,7 @@ Eigen::VectorXd vector_in(nb::handle h, const char* fn, const char* name, Eigen:
 }
 
 /// A data set from arrays (the same fields read_dataset fills), for fit() and loop().
-softrne::io::Dataset dataset_from_arrays(const Robot& r, nb::handle t, nb::handle pressures, nb::handle angles,
+softrne::io::Dataset dataset_from_arrays(const Robot& r, const ArrayLike& t, const ArrayLike& pressures, const ArrayLike& angles,
                                          const std::string& source) {
   softrne::io::Dataset d;
   d.t = vector_in(t, "Dataset", "t");
@@ -444,7 +457,10 @@ NB_MODULE(_softrne, m) {
           },
           "text"_a, "source"_a = "<string>", "A robot from the text of a robot file.")
       .def(
-          "to_dict", [](const Robot& r) { return to_python(softrne::io::to_ordered_json(softrne::to_robot_spec(r.desc))); },
+          "to_dict",
+          [](const Robot& r) {
+            return nb::borrow<nb::dict>(to_python(softrne::io::to_ordered_json(softrne::to_robot_spec(r.desc))));
+          },
           "The robot as the dict of its softrne-robot/1 file (keys in the documented order).")
       .def(
           "to_json",
@@ -477,7 +493,7 @@ NB_MODULE(_softrne, m) {
 
   robot.def(
       "rnea",
-      [](Robot& r, nb::handle q, nb::handle qd, nb::handle qdd, int threads) {
+      [](Robot& r, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& qdd, int threads) {
         const States s = states(r, "rnea", {{"q", q}, {"qd", qd}, {"qdd", qdd}});
         const int nq = r.nq();
         return evaluate(r, s, {static_cast<size_t>(nq)}, threads, [nq, &r](Data& d, const double* const* in, double* out) {
@@ -492,7 +508,7 @@ NB_MODULE(_softrne, m) {
           .c_str());
   robot.def(
       "mass_matrix",
-      [](Robot& r, nb::handle q, int threads) {
+      [](Robot& r, const ArrayLike& q, int threads) {
         const States s = states(r, "mass_matrix", {{"q", q}});
         const int nq = r.nq();
         return evaluate(r, s, {static_cast<size_t>(nq), static_cast<size_t>(nq)}, threads,
@@ -504,7 +520,7 @@ NB_MODULE(_softrne, m) {
       (std::string("The joint-space mass matrix M(q), shape (nq, nq) (symmetric, positive definite).") + kThreadsDoc).c_str());
   robot.def(
       "gravity",
-      [](Robot& r, nb::handle q, int threads) {
+      [](Robot& r, const ArrayLike& q, int threads) {
         const States s = states(r, "gravity", {{"q", q}});
         const int nq = r.nq();
         return evaluate(r, s, {static_cast<size_t>(nq)}, threads, [nq, &r](Data& d, const double* const* in, double* out) {
@@ -518,7 +534,7 @@ NB_MODULE(_softrne, m) {
           .c_str());
   robot.def(
       "bias",
-      [](Robot& r, nb::handle q, nb::handle qd, bool with_gravity, int threads) {
+      [](Robot& r, const ArrayLike& q, const ArrayLike& qd, bool with_gravity, int threads) {
         const States s = states(r, "bias", {{"q", q}, {"qd", qd}});
         const int nq = r.nq();
         return evaluate(r, s, {static_cast<size_t>(nq)}, threads,
@@ -533,7 +549,7 @@ NB_MODULE(_softrne, m) {
           .c_str());
   robot.def(
       "forward_dynamics",
-      [](Robot& r, nb::handle q, nb::handle qd, nb::handle tau, int threads) {
+      [](Robot& r, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& tau, int threads) {
         const States s = states(r, "forward_dynamics", {{"q", q}, {"qd", qd}, {"tau", tau}});
         const int nq = r.nq();
         return evaluate(r, s, {static_cast<size_t>(nq)}, threads, [nq, &r](Data& d, const double* const* in, double* out) {
@@ -548,7 +564,7 @@ NB_MODULE(_softrne, m) {
           .c_str());
   robot.def(
       "aba",
-      [](Robot& r, nb::handle q, nb::handle qd, nb::handle tau, int threads) {
+      [](Robot& r, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& tau, int threads) {
         const States s = states(r, "aba", {{"q", q}, {"qd", qd}, {"tau", tau}});
         const int nq = r.nq();
         return evaluate(r, s, {static_cast<size_t>(nq)}, threads, [nq, &r](Data& d, const double* const* in, double* out) {
@@ -562,7 +578,7 @@ NB_MODULE(_softrne, m) {
           .c_str());
   robot.def(
       "frames",
-      [](Robot& r, nb::handle q, int threads) {
+      [](Robot& r, const ArrayLike& q, int threads) {
         const States s = states(r, "frames", {{"q", q}});
         const int nq = r.nq();
         const size_t nseg = static_cast<size_t>(r.chain.num_segments());
@@ -591,7 +607,7 @@ NB_MODULE(_softrne, m) {
                                    "optionally measured angles, in the robot's column order.")
       .def(
           "__init__",
-          [](softrne::io::Dataset* self, const Robot& r, nb::handle t, nb::handle pressures, nb::handle angles,
+          [](softrne::io::Dataset* self, const Robot& r, const ArrayLike& t, const ArrayLike& pressures, const ArrayLike& angles,
              const std::string& source) {
             new (self) softrne::io::Dataset(dataset_from_arrays(r, t, pressures, angles, source));
           },
@@ -627,7 +643,7 @@ NB_MODULE(_softrne, m) {
       "InputError naming the file, line and column.");
   m.def(
       "write_dataset",
-      [](const std::filesystem::path& path, const Robot& r, nb::handle t, nb::handle pressures, nb::handle angles) {
+      [](const std::filesystem::path& path, const Robot& r, const ArrayLike& t, const ArrayLike& pressures, const ArrayLike& angles) {
         const Eigen::VectorXd tv = vector_in(t, "write_dataset", "t");
         const Eigen::Index N = tv.size();
         std::vector<Eigen::MatrixXd> blocks;
@@ -660,7 +676,7 @@ NB_MODULE(_softrne, m) {
   // ---- simulation, fit, loop -------------------------------------------------------------
   m.def(
       "simulate",
-      [](const Robot& r, nb::handle t, nb::handle pressures, nb::handle q0, const nb::kwargs& kw) {
+      [](const Robot& r, const ArrayLike& t, const ArrayLike& pressures, const ArrayLike& q0, const nb::kwargs& kw) {
         const Eigen::VectorXd tv = vector_in(t, "simulate", "t");
         if (tv.size() < 2) throw nb::value_error("softrne.simulate: t needs at least 2 samples");
         const Eigen::MatrixXd p = matrix_in(pressures, "simulate", "pressures", tv.size(), r.desc.num_inputs);
