@@ -9,7 +9,10 @@
 // batch of states an array (N, nq); results have the same leading shape. Batches run without
 // the GIL on several threads, one workspace (DynamicChainData) per thread.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <csignal>
+#include <optional>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -373,26 +376,63 @@ softrne::sim::ArmSimulationOptions simulation_options(const nb::kwargs& kw, doub
   return opt;
 }
 
-/// Python's Ctrl-C during a long C++ run: polled from the progress callbacks (GIL taken
-/// briefly), it sets the flag CVODE's stop pointer watches.
-struct InterruptFlag {
-  std::atomic<bool> stop{false};
-  std::atomic<int> calls{0};
-  void poll() {
-    if (stop.load() || (++calls % 16) != 0) return;
-    nb::gil_scoped_acquire gil;
-    if (PyErr_CheckSignals() != 0) {
-      PyErr_Clear();
-      stop = true;
+/// Set by Ctrl-C while a simulation, fit or loop runs (InterruptScope); CVODE's stop pointer
+/// watches it, so the run ends within one simulation step, as the tools' do.
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_sigint(int) { g_interrupted.store(true); }
+
+/// \brief Ctrl-C during a long C++ run without the GIL: Python's own SIGINT handler only
+/// sets a flag that no Python code looks at until the run ends, so for its duration (called
+/// from the main thread, where Python receives signals) a C handler sets g_interrupted, and
+/// Python's handler is restored afterwards. raise_if_interrupted() then raises
+/// KeyboardInterrupt.
+class InterruptScope {
+ public:
+  InterruptScope() {
+    g_interrupted.store(false);
+    const bool main_thread =
+        nb::module_::import_("threading").attr("main_thread")().is(nb::module_::import_("threading").attr("current_thread")());
+    if (main_thread) {
+      previous_ = std::signal(SIGINT, on_sigint);
+      installed_ = previous_ != SIG_ERR;
     }
   }
-  /// After the run, with the GIL: the KeyboardInterrupt that stopped it.
-  void raise_if_stopped() const {
-    if (!stop.load()) return;
-    PyErr_SetNone(PyExc_KeyboardInterrupt);
-    throw nb::python_error();
+  ~InterruptScope() {
+    if (installed_) std::signal(SIGINT, previous_);
   }
+  InterruptScope(const InterruptScope&) = delete;
+  InterruptScope& operator=(const InterruptScope&) = delete;
+  const std::atomic<bool>* flag() const { return &g_interrupted; }
+
+ private:
+  bool installed_ = false;
+  void (*previous_)(int) = nullptr;
 };
+
+/// With the GIL, after the InterruptScope ended: the KeyboardInterrupt of a Ctrl-C.
+void raise_if_interrupted() {
+  if (!g_interrupted.load()) return;
+  g_interrupted.store(false);
+  PyErr_SetNone(PyExc_KeyboardInterrupt);
+  throw nb::python_error();
+}
+
+/// Runs `f` without the GIL and with Ctrl-C watched; a failure caused by the interrupt
+/// (a simulation stopped on request) is a KeyboardInterrupt.
+template <class F>
+auto run_interruptible(F&& f) {
+  std::optional<decltype(f(g_interrupted))> result;
+  try {
+    InterruptScope scope;
+    nb::gil_scoped_release release;
+    result.emplace(f(g_interrupted));
+  } catch (const std::exception&) {
+    raise_if_interrupted();
+    throw;
+  }
+  raise_if_interrupted();
+  return std::move(*result);
+}
 
 }  // namespace
 
@@ -682,15 +722,10 @@ NB_MODULE(_softrne, m) {
         const Eigen::MatrixXd p = matrix_in(pressures, "simulate", "pressures", tv.size(), r.desc.num_inputs);
         const Eigen::VectorXd q = q0.is_none() ? Eigen::VectorXd::Zero(r.desc.nq) : vector_in(q0, "simulate", "q0", r.desc.nq);
         softrne::sim::ArmSimulationOptions opt = simulation_options(kw, tv(0), tv(tv.size() - 1));
-        InterruptFlag flag;
-        opt.cvode.stop = &flag.stop;
-        opt.progress = [&flag](double) { flag.poll(); };
-        softrne::sim::ArmSimulation sim;
-        {
-          nb::gil_scoped_release release;
-          sim = softrne::sim::simulate_arm(r.desc, tv, p, q, opt);
-        }
-        flag.raise_if_stopped();
+        const softrne::sim::ArmSimulation sim = run_interruptible([&](const std::atomic<bool>& stop) {
+          opt.cvode.stop = &stop;
+          return softrne::sim::simulate_arm(r.desc, tv, p, q, opt);
+        });
         if (!sim.ok()) throw softrne::cli::Failure("softrne.simulate: " + sim.result.message);
         return matrix_out(sim.angles);
       },
@@ -712,15 +747,10 @@ NB_MODULE(_softrne, m) {
         opt.pressure_gain = pressure_gain;
         opt.optimiser.seed = seed;
         opt.optimiser.threads = std::max(1, threads);
-        InterruptFlag flag;
-        opt.simulation.cvode.stop = &flag.stop;
-        opt.optimiser.progress = [&flag](int, double) { flag.poll(); };
-        nlohmann::ordered_json report;
-        {
-          nb::gil_scoped_release release;
-          report = softrne::cli::fit_report_json(softrne::cli::run_fit(r.desc, train, test, opt));
-        }
-        flag.raise_if_stopped();
+        const nlohmann::ordered_json report = run_interruptible([&](const std::atomic<bool>& stop) {
+          opt.simulation.cvode.stop = &stop;
+          return softrne::cli::fit_report_json(softrne::cli::run_fit(r.desc, train, test, opt));
+        });
         return to_python(report);
       },
       "robot"_a, "train"_a, "test"_a.none(), "pressure_gain"_a, "seed"_a, "threads"_a);
@@ -731,24 +761,19 @@ NB_MODULE(_softrne, m) {
         softrne::fit::LoopOptions opt;
         opt.fit.optimiser.threads = std::max(1, threads);
         opt.max_effects = max_effects;
-        InterruptFlag flag;
-        opt.fit.simulation.cvode.stop = &flag.stop;
-        opt.fit.optimiser.progress = [&flag](int, double) { flag.poll(); };
         if (!log.is_none())
           opt.log = [&log](const std::string& line) {
             nb::gil_scoped_acquire gil;
             log(line);
           };
-        softrne::fit::LoopResult res;
-        {
-          nb::gil_scoped_release release;
+        const softrne::fit::LoopResult res = run_interruptible([&](const std::atomic<bool>& stop) {
+          opt.fit.simulation.cvode.stop = &stop;
           try {
-            res = softrne::fit::run_loop(r.desc, train, &test, opt);
+            return softrne::fit::run_loop(r.desc, train, &test, opt);
           } catch (const std::invalid_argument& e) {
             throw softrne::cli::Failure(e.what());
           }
-        }
-        flag.raise_if_stopped();
+        });
         return to_python(softrne::cli::loop_report_json(res, true, opt));
       },
       "robot"_a, "train"_a, "test"_a, "threads"_a, "max_effects"_a, "log"_a.none());

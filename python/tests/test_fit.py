@@ -76,3 +76,34 @@ def test_loop_same_report_as_softrne_loop(robot, short_files, tmp_path):
     assert report["format"] == "softrne-loop-report/2"
     assert without_timing(report) == without_timing(expected)
     assert lines and all(isinstance(s, str) for s in lines)
+
+
+def test_ctrl_c_stops_a_fit():
+    """SIGINT during fit() (no GIL, C++ running) raises KeyboardInterrupt within a simulation
+    step, and Python's own handler is back afterwards."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    code = f"""
+import signal, sys, time, softrne
+r = softrne.Robot.from_json({str(ARM / 'robot.json')!r})
+print('started', flush=True)
+t0 = time.time()
+try:
+    softrne.fit(r, {str(ARM / 'train.csv')!r})
+    print('finished', flush=True)
+except KeyboardInterrupt:
+    print('interrupted', round(time.time() - t0, 2), signal.getsignal(signal.SIGINT) is signal.default_int_handler, flush=True)
+"""
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, env=os.environ)
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(0.5)  # the fit takes seconds
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=60)
+    assert p.returncode == 0
+    words = out.split()
+    assert words[0] == "interrupted", out
+    assert float(words[1]) < 5.0 and words[2] == "True", out
