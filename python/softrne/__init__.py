@@ -46,6 +46,11 @@ __version__ = "0.1.0"
 PathOrDataset = Union[str, "os.PathLike[str]", Dataset]
 
 
+def _robot_from_dict(d: dict) -> Robot:
+    """What pickle calls to rebuild a Robot (Robot.__reduce__)."""
+    return Robot.from_dict(d)
+
+
 def _dataset(robot: Robot, data: PathOrDataset) -> Dataset:
     if isinstance(data, Dataset):
         return data

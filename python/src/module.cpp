@@ -9,6 +9,7 @@
 // batch of states an array (N, nq); results have the same leading shape. Batches run without
 // the GIL on several threads, one workspace (DynamicChainData) per thread.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -133,9 +134,10 @@ Array as_array(nb::handle h, const char* fn, const char* name) {
 
 /// \brief The arguments of one algorithm: each (nq,) (one state) or (N, nq) (a batch), all alike.
 struct States {
-  std::vector<Array> arrays;
-  size_t n = 1;          ///< states
-  bool batched = false;  ///< 2-D arguments
+  std::array<Array, 3> arrays;  ///< fixed storage: no allocation per call
+  size_t count = 0;             ///< arguments
+  size_t n = 1;                 ///< states
+  bool batched = false;         ///< 2-D arguments
   const double* row(size_t arg, size_t k, int nq) const {
     return arrays[arg].data() + k * static_cast<size_t>(nq);
   }
@@ -161,28 +163,26 @@ States states(const Robot& r, const char* fn, std::initializer_list<std::pair<co
       s.n = n;
     } else if (batched != s.batched || n != s.n) {
       throw nb::value_error((std::string("softrne.") + fn + ": " + name + " has shape " + shape_text(a) +
-                             " but " + first + " has shape " + shape_text(s.arrays.front()) +
+                             " but " + first + " has shape " + shape_text(s.arrays[0]) +
                              ": give every argument as one state (nq,) or all as N states (N, nq)")
                                 .c_str());
     }
-    s.arrays.push_back(std::move(a));
+    s.arrays[s.count++] = std::move(a);
   }
   return s;
 }
 
-/// \brief A new numpy array of float64 of `shape` (numpy C API); `out` its data.
-template <class Shape>
-OutArray new_array(const Shape& shape, double*& out) {
-  npy_intp dims[8];
-  int nd = 0;
-  for (size_t d : shape) dims[nd++] = static_cast<npy_intp>(d);
-  PyObject* a = PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
+/// \brief A new numpy array of float64 of shape shape[0..nd) (numpy C API); `out` its data.
+OutArray new_array(size_t nd, const size_t* shape, double*& out) {
+  npy_intp dims[4];
+  for (size_t i = 0; i < nd; ++i) dims[i] = static_cast<npy_intp>(shape[i]);
+  PyObject* a = PyArray_SimpleNew(static_cast<int>(nd), dims, NPY_DOUBLE);
   if (!a) throw nb::python_error();
   out = static_cast<double*>(PyArray_DATA(reinterpret_cast<PyArrayObject*>(a)));
   return nb::steal<NDArray>(a);
 }
 OutArray new_array(std::initializer_list<size_t> shape, double*& out) {
-  return new_array<std::initializer_list<size_t>>(shape, out);
+  return new_array(shape.size(), shape.begin(), out);
 }
 
 int thread_count(int threads) {
@@ -196,16 +196,17 @@ int thread_count(int threads) {
 /// core), one workspace per thread. `out_size` doubles per state; `out_shape` the shape of
 /// one state's result.
 template <class Kernel>
-OutArray evaluate(Robot& r, const States& s, std::vector<size_t> out_shape, int threads, Kernel kernel) {
+OutArray evaluate(Robot& r, const States& s, std::initializer_list<size_t> out_shape, int threads, Kernel kernel) {
   size_t per_state = 1;
   for (size_t d : out_shape) per_state *= d;
   const int nq = r.nq();
-  const size_t nargs = s.arrays.size();
+  const size_t nargs = s.count;
   double* out = nullptr;
-  std::vector<size_t> shape;
-  if (s.batched) shape.push_back(s.n);
-  shape.insert(shape.end(), out_shape.begin(), out_shape.end());
-  OutArray result = new_array(shape, out);
+  std::array<size_t, 4> shape{};
+  size_t nd = 0;
+  if (s.batched) shape[nd++] = s.n;
+  for (size_t d : out_shape) shape[nd++] = d;
+  OutArray result = new_array(nd, shape.data(), out);
   const double* in[3] = {nullptr, nullptr, nullptr};
   if (!s.batched) {
     for (size_t a = 0; a < nargs; ++a) in[a] = s.arrays[a].data();
@@ -526,6 +527,15 @@ NB_MODULE(_softrne, m) {
           "one frame each in frames().")
       .def_prop_ro("gravity_vector", [](const Robot& r) { return vector_out(r.chain.gravity); }, 
                    "Gravitational acceleration in the base frame (m/s^2).")
+      .def(
+          "__reduce__",
+          [](nb::handle self) {
+            // Pickled as its description: Robot.from_dict(robot.to_dict()) (multiprocessing, Dask).
+            // (A Python function: pickle cannot store nanobind's static methods by name.)
+            return nb::make_tuple(nb::module_::import_("softrne").attr("_robot_from_dict"),
+                                  nb::make_tuple(self.attr("to_dict")()));
+          },
+          "Pickles the robot as its description (Robot.from_dict of to_dict()).")
       .def("__repr__", [](const Robot& r) {
         return "softrne.Robot('" + r.desc.spec.name + "', nq=" + std::to_string(r.nq()) + ", segments=" +
                std::to_string(r.chain.num_segments()) + ")";

@@ -157,3 +157,12 @@ def test_bad_csv_same_message_as_tools(robot, tmp_path):
         expected = tool_error([sim, "--robot", str(ARM / "robot.json"), "--pressures", str(path)])
         assert str(e.value) == expected
         assert "line" in e.value.where
+
+
+def test_robot_pickles(robot, rng):
+    import pickle
+
+    r2 = pickle.loads(pickle.dumps(robot))
+    assert r2.to_dict() == robot.to_dict()
+    q, qd, qdd = rng.uniform(-0.5, 0.5, (3, robot.nq))
+    np.testing.assert_array_equal(r2.rnea(q, qd, qdd), robot.rnea(q, qd, qdd))
