@@ -23,7 +23,10 @@ fi
 python_mode=${SOFTRNE_PYTHON:-auto}
 py_args=()
 if [[ $python_mode != 0 ]]; then
-  if py=$(./tools/setup-python.sh "$build_dir/py-venv"); then
+  # An absolute path: CMake resolves a relative Python_EXECUTABLE against nothing useful and
+  # then quietly finds another python.
+  case $build_dir in /*) venv_dir=$build_dir/py-venv ;; *) venv_dir=$PWD/$build_dir/py-venv ;; esac
+  if py=$(./tools/setup-python.sh "$venv_dir"); then
     echo "[run-tests] Python package: on ($py)"
     py_args=(-DSOFTRNE_BUILD_PYTHON=ON "-DPython_EXECUTABLE=$py")
   elif [[ $python_mode == 1 ]]; then

@@ -43,4 +43,4 @@ if ! "$py" -c 'import numpy, nanobind, pytest' >/dev/null 2>&1; then
     exit 1
   fi
 fi
-echo "$py"
+echo "$(cd "$venv" && pwd)/bin/python"
