@@ -23,6 +23,8 @@ APT_PACKAGES=(
   ninja-build
   g++
   python3
+  python3-venv       # the Python package's build and tests (tools/setup-python.sh: a venv)
+  python3-dev        # Python.h for the extension
   python3-numpy      # plotting scripts
   python3-matplotlib
 )

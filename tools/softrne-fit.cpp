@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
         "robot's effects) to measured angles by simulation error: the model is simulated from "
         "the first sample with the recorded pressures. Prints the fitted values with their "
         "standard errors and the error tables (paper Tables I-II) before and after.");
-    std::string robot_path, data_path, out_path, test_path;
+    std::string robot_path, data_path, out_path, test_path, report_path;
     fit::ArmFitOptions opt;
     app.add_option("--robot", robot_path,
                    "robot description (softrne-robot/1); its values are the starting guesses")
@@ -32,6 +32,10 @@ int main(int argc, char** argv) {
         ->required();
     app.add_option("--test", test_path, "a held-out data set: only measured, never fitted")
         ->type_name("test.csv");
+    app.add_option("--report", report_path,
+                   "also write the fit report here (softrne-fit-report/1: parameters, standard "
+                   "errors, error statistics, fitted robot)")
+        ->type_name("R.json");
     app.add_flag("--pressure-gain", opt.pressure_gain, "also fit one gain on K_prs per CC joint");
     app.add_option("--seed", opt.optimiser.seed, "optimiser seed")
         ->type_name("N")
@@ -49,7 +53,7 @@ int main(int argc, char** argv) {
     if (!app.parse_command_line(argc, argv)) return cli::kExitOk;
     cli::check_outputs_are_not_inputs(
         {{"--robot", robot_path}, {"--data", data_path}, {"--test", test_path}},
-        {{"--out", out_path}});
+        {{"--out", out_path}, {"--report", report_path}});
     const io::RobotSpec spec = io::read_robot_json(robot_path);
     const io::Dataset train = io::read_dataset(data_path, spec, true);
     io::Dataset test;
@@ -67,34 +71,23 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "\rsoftrne-fit: %d simulations, best rms error %.5f rad   ", evals,
                      std::sqrt(2 * cost / nq));
       };
-    auto before = [&](const io::Dataset& d) {
-      const auto s = fit::simulate_dataset(desc, d, opt.simulation);
-      if (!s.ok()) throw cli::Failure(d.source + ": the starting model fails to simulate: " + s.result.message);
-      return error_stats(s.angles, d.angles, desc.coordinate_names);
-    };
-    const ErrorStats train_before = before(train);
-    fit::ArmFitResult r;
     cli::stop_on_interrupt();
     opt.simulation.cvode.stop = &cli::interrupted;
-    try {
-      r = fit::fit_arm(desc, train, opt);
-    } catch (const std::invalid_argument& e) {
-      throw cli::Failure(e.what());
-    }
+    const cli::FitRun run = cli::run_fit(desc, train, has_test ? &test : nullptr, opt);
     cli::throw_if_interrupted("the fit");
     if (!quiet) std::fprintf(stderr, "\n");
-    if (!std::isfinite(r.fit.cost)) throw cli::Failure(train.source + ": the fit found no parameters that simulate: " + r.fit.message);
+    const fit::ArmFitResult& r = run.result;
     io::write_robot_json(to_robot_spec(r.fitted), out_path);
+    if (!report_path.empty())
+      io::detail::write_text_file(report_path, cli::fit_report_json(run).dump(2) + "\n");
     std::printf("fitted %d parameters in %.1f s (%d simulations)\n", r.parameters.size(), r.wall_seconds, r.simulations);
     std::printf("%s", cli::parameter_table(r).c_str());
     if (!r.fit.identifiability_report.empty()) std::printf("identifiability:\n%s\n", r.fit.identifiability_report.c_str());
-    std::printf("%s", format_error_table(train_before, "train, before (" + train.source + ")").c_str());
+    std::printf("%s", format_error_table(run.train_before, "train, before (" + train.source + ")").c_str());
     std::printf("%s", format_error_table(r.stats, "train, after").c_str());
     if (has_test) {
-      std::printf("%s", format_error_table(before(test), "test, before (" + test.source + ")").c_str());
-      const auto s = fit::simulate_dataset(r.fitted, test, opt.simulation);
-      if (!s.ok()) throw cli::Failure(test.source + ": the fitted model fails to simulate: " + s.result.message);
-      std::printf("%s", format_error_table(error_stats(s.angles, test.angles, r.fitted.coordinate_names), "test, after").c_str());
+      std::printf("%s", format_error_table(run.test_before, "test, before (" + test.source + ")").c_str());
+      std::printf("%s", format_error_table(run.test_after, "test, after").c_str());
     }
     std::printf("wrote %s\n", out_path.c_str());
     return cli::kExitOk;

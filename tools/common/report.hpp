@@ -1,12 +1,16 @@
 #pragma once
 /// \file
-/// \brief JSON of error statistics and of the closed-loop report (formats.md section 5).
+/// \brief JSON of error statistics, of a fit and of the closed-loop report (formats.md
+/// section 5), and the fit as softrne-fit runs it. Shared by the tools and the Python module
+/// (python/src/module.cpp), which return the same reports.
 
 #include <cmath>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "common/cli.hpp"
+#include "softrne/fit/arm_fit.hpp"
 #include "softrne/fit/loop.hpp"
 #include "softrne/io/robot_json.hpp"
 #include "softrne/model/error_stats.hpp"
@@ -72,6 +76,74 @@ inline nlohmann::ordered_json unexplained_json(const fit::UnexplainedResidual& u
                                    {"2_10Hz", c.band_power.size() > 2 ? c.band_power[2] : 0.0},
                                    {"above_10Hz", c.band_power.size() > 3 ? c.band_power[3] : 0.0}}}};
   j["per_angle"] = per;
+  return j;
+}
+
+/// \brief A fit as softrne-fit runs it: the error statistics of the starting model, the fit,
+/// and where a held-out data set is given the errors of both models on it.
+struct FitRun {
+  fit::ArmFitResult result;
+  ErrorStats train_before;
+  bool has_test = false;
+  ErrorStats test_before, test_after;
+};
+
+/// \brief Error statistics of model `d` simulated on `data`; cli::Failure naming the data set
+/// if it does not simulate (`which`: "starting", "fitted").
+inline ErrorStats simulated_errors(const ArmDescription& d, const io::Dataset& data,
+                                   const sim::ArmSimulationOptions& opt, const std::string& which) {
+  const auto s = fit::simulate_dataset(d, data, opt);
+  if (!s.ok())
+    throw Failure(data.source + ": the " + which + " model fails to simulate: " + s.result.message);
+  return error_stats(s.angles, data.angles, d.coordinate_names);
+}
+
+/// \brief Fits `desc` to `train` (fit::fit_arm) and measures it before and after, on `train`
+/// and on `test` if given. cli::Failure when a model does not simulate or the fit finds no
+/// parameters that do.
+inline FitRun run_fit(const ArmDescription& desc, const io::Dataset& train, const io::Dataset* test,
+                      const fit::ArmFitOptions& opt) {
+  FitRun run;
+  run.train_before = simulated_errors(desc, train, opt.simulation, "starting");
+  try {
+    run.result = fit::fit_arm(desc, train, opt);
+  } catch (const std::invalid_argument& e) {
+    throw Failure(e.what());
+  }
+  if (!std::isfinite(run.result.fit.cost))
+    throw Failure(train.source + ": the fit found no parameters that simulate: " + run.result.fit.message);
+  if (test) {
+    run.has_test = true;
+    run.test_before = simulated_errors(desc, *test, opt.simulation, "starting");
+    run.test_after = simulated_errors(run.result.fitted, *test, opt.simulation, "fitted");
+  }
+  return run;
+}
+
+/// \brief The fit report (format softrne-fit-report/1, formats.md section 5): softrne-fit
+/// --report, softrne.fit() in Python.
+inline nlohmann::ordered_json fit_report_json(const FitRun& run) {
+  const fit::ArmFitResult& r = run.result;
+  nlohmann::ordered_json j;
+  j["format"] = "softrne-fit-report/1";
+  nlohmann::ordered_json params = nlohmann::ordered_json::array();
+  for (int i = 0; i < r.parameters.size(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    params.push_back(
+        {{"name", r.parameters[i].name},
+         {"value", r.fit.params.size() > i ? r.fit.params(i) : r.parameters[i].initial},
+         {"std_error", finite_or_null(r.fit.std_errors.size() > i ? r.fit.std_errors(i) : INFINITY)},
+         {"identifiable", r.fit.identifiable.size() > k ? static_cast<bool>(r.fit.identifiable[k]) : false}});
+  }
+  j["parameters"] = params;
+  j["identifiability"] = r.fit.identifiability_report;
+  j["train"] = {{"before", stats_json(run.train_before)}, {"after", stats_json(r.stats)}};
+  if (run.has_test) j["test"] = {{"before", stats_json(run.test_before)}, {"after", stats_json(run.test_after)}};
+  j["converged"] = r.fit.converged;
+  j["message"] = r.fit.message;
+  j["simulations"] = r.simulations;
+  j["wall_seconds"] = r.wall_seconds;
+  j["fitted_robot"] = io::to_ordered_json(to_robot_spec(r.fitted));
   return j;
 }
 
