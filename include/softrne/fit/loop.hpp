@@ -523,9 +523,11 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     // shared effect's signal dominates the screen's linearised gains, so two narrower scopes
     // on that joint could take the effect's two refits (random arms 1029 and 1034: actuator
     // lag and pressure stiffening on both joints, reported on one). It starts in each fold
-    // where the narrower refit ended when that holds one value per kind (one joint), else at
-    // the screen's start. The held-out gain below then chooses: on a truly per-joint effect
-    // the shared scope puts the effect where it is not and loses.
+    // from the narrower refit's model, with the narrower refit's values when those are one
+    // per kind (one joint), else the screen's; also when the screen had the shared scope
+    // refitted already (confirm keeps the better refit). The held-out gain below then
+    // chooses: on a truly per-joint effect the shared scope puts the effect where it is not
+    // and loses.
     const std::vector<int> passed_before_shared = passing;
     for (int narrow_index : passed_before_shared) {
       const std::size_t narrow = static_cast<std::size_t>(narrow_index);
