@@ -37,17 +37,11 @@ int main(int argc, char** argv) {
                    "errors, error statistics, fitted robot)")
         ->type_name("R.json");
     app.add_flag("--pressure-gain", opt.pressure_gain, "also fit one gain on K_prs per CC joint");
-    app.add_option("--seed", opt.optimiser.seed, "optimiser seed")
-        ->type_name("N")
-        ->capture_default_str()
-        ->transform(cli::DecimalInteger)
-        ->check(CLI::Range(0L, 4294967295L));
+    app.add_integer("--seed", opt.optimiser.seed, "optimiser seed", 0L, 4294967295L)
+        ->capture_default_str();
     opt.optimiser.threads = 2;
-    app.add_option("--threads", opt.optimiser.threads, "parallel simulations")
-        ->type_name("N")
-        ->capture_default_str()
-        ->transform(cli::DecimalInteger)
-        ->check(CLI::Range(1, 64));
+    app.add_integer("--threads", opt.optimiser.threads, "parallel simulations", 1, 64)
+        ->capture_default_str();
     bool quiet = false;
     app.add_flag("--quiet", quiet, "no progress line");
     if (!app.parse_command_line(argc, argv)) return cli::kExitOk;

@@ -79,16 +79,10 @@ int main(int argc, char** argv) {
                    "SOFTRNE_PYTHON)")
         ->type_name("DIR");
     opt.fit.optimiser.threads = 2;
-    app.add_option("--threads", opt.fit.optimiser.threads, "parallel simulations")
-        ->type_name("N")
-        ->capture_default_str()
-        ->transform(cli::DecimalInteger)
-        ->check(CLI::Range(1, 64));
-    app.add_option("--max-effects", opt.max_effects, "at most this many effects")
-        ->type_name("N")
-        ->capture_default_str()
-        ->transform(cli::DecimalInteger)
-        ->check(CLI::Range(0, 16));
+    app.add_integer("--threads", opt.fit.optimiser.threads, "parallel simulations", 1, 64)
+        ->capture_default_str();
+    app.add_integer("--max-effects", opt.max_effects, "at most this many effects", 0, 16)
+        ->capture_default_str();
     bool quiet = false;
     app.add_flag("--quiet", quiet, "no progress lines");
     if (!app.parse_command_line(argc, argv)) return cli::kExitOk;

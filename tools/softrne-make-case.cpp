@@ -159,11 +159,7 @@ int run(int argc, char** argv) {
   gen::CaseOptions opt;
   std::string effects, out;
   bool none = false, no_calibrate = false, quiet = false, list = false;
-  app.add_option("--seed", opt.seed, "case seed")
-      ->type_name("N")
-      ->required()
-      ->transform(softrne::cli::DecimalInteger)
-      ->check(CLI::Range(0L, 2147483647L));
+  app.add_integer("--seed", opt.seed, "case seed", 0L, 2147483647L)->required();
   CLI::App* inject = app.add_option_group("injection", "what to inject");
   inject
       ->add_option(

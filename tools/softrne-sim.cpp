@@ -123,11 +123,8 @@ int run_sim(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::IsMember({"ad", "ad-forward", "fd"}));
   long max_steps = 0;
-  app.add_option("--max-steps", max_steps, "integrator step limit")
-      ->type_name("N")
-      ->default_str("max(1e5, 1e4 per s)")
-      ->transform(softrne::cli::DecimalInteger)
-      ->check(CLI::Range(1L, 1000000000L));
+  app.add_integer("--max-steps", max_steps, "integrator step limit", 1L, 1000000000L)
+      ->default_str("max(1e5, 1e4 per s)");
   bool quiet = false;
   app.add_flag("--quiet", quiet,
                "no progress indicator (shown on a terminal for runs over a second) and no solver "

@@ -12,9 +12,7 @@
 ///       std::string in;
 ///       int threads = 2;
 ///       app.add_option("--in", in, "input file")->type_name("F")->required();
-///       app.add_option("--threads", threads, "parallel jobs")->type_name("N")
-///           ->capture_default_str()->transform(softrne::cli::DecimalInteger)->check(CLI::Range(1,
-///           64));
+///       app.add_integer("--threads", threads, "parallel jobs", 1, 64)->capture_default_str();
 ///       if (!app.parse_command_line(argc, argv)) return softrne::cli::kExitOk;  // --help
 ///       ...
 ///       return softrne::cli::kExitOk;
@@ -281,6 +279,18 @@ class App : public CLI::App {
     add_flag_callback(
         "-h,--help", [] { throw CLI::CallForHelp(); }, "print this help and exit")
         ->trigger_on_parse();
+  }
+
+  /// \brief An integer option in [lo, hi]: decimal digits only (DecimalInteger), then the
+  /// range. Every integer option of the tools is made here, so none can miss the decimal
+  /// check; the caller adds required() or a default text.
+  template <class T, class Bound>
+  CLI::Option* add_integer(const std::string& name, T& value, const std::string& help, Bound lo,
+                           Bound hi) {
+    return add_option(name, value, help)
+        ->type_name("N")
+        ->transform(DecimalInteger)
+        ->check(CLI::Range(lo, hi));
   }
 
   /// \brief Parses argv. \return false if the tool is done and exits 0: --help was asked for
