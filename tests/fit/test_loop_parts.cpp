@@ -217,3 +217,22 @@ TEST(LoopParts, DistributeInertiaSwitchesLumpedCcJointsOnly) {
 }
 
 }  // namespace
+
+// The confirmation slots go to distinct effects first, then to second scopes, in screen order,
+// and never to a candidate predicted below the threshold (random arm 1039: two scopes each of
+// two effects took all four slots before the rule and the true effect, fifth, got none).
+TEST(LoopConfirmation, DistinctEffectsFirstThenSecondScopes) {
+  using softrne::fit::detail::confirmation_picks;
+  const std::vector<std::string> names = {"chamber_gain", "sensor_gain", "chamber_gain",
+                                          "sensor_gain",  "mass_scale",  "payload",
+                                          "mass_scale",   "angle_offset"};
+  const std::vector<double> gains = {0.62, 0.60, 0.58, 0.55, 0.45, 0.30, 0.20, 0.005};
+  EXPECT_EQ(confirmation_picks(names, gains, 4, 0.01), (std::vector<std::size_t>{0, 1, 4, 5}));
+  // With slots left after every effect's best scope: the second scopes, in screen order.
+  EXPECT_EQ(confirmation_picks(names, gains, 6, 0.01), (std::vector<std::size_t>{0, 1, 4, 5, 2, 3}));
+  EXPECT_EQ(confirmation_picks(names, gains, 20, 0.01),
+            (std::vector<std::size_t>{0, 1, 4, 5, 2, 3, 6}));  // never a third scope, nor < 1 %
+  EXPECT_EQ(confirmation_picks(names, gains, 20, 0.50), (std::vector<std::size_t>{0, 1, 2, 3}));
+  EXPECT_TRUE(confirmation_picks(names, gains, 0, 0.01).empty());
+  EXPECT_TRUE(confirmation_picks({}, {}, 4, 0.01).empty());
+}

@@ -14,9 +14,10 @@
 ///     held-out gain per fold from sensitivities of the fold's simulated trajectory.
 ///  4. Confirmation: each fold's base model first gets the same local refit a candidate gets
 ///     (so that no candidate earns credit for K, D iterations the base had not had); then the
-///     best `candidates_to_confirm` candidates are refitted in each fold (the
-///     effect with every stiffness, damping and effect already held, by simulation error on the
-///     fold's training blocks, from the fold's base model and the fold's own screening step),
+///     best `candidates_to_confirm` candidates (the best scope of each effect first, then
+///     second scopes) are refitted in each fold (the effect with every stiffness, damping and
+///     effect already held, by simulation error on the fold's training blocks, from the fold's
+///     base model and the fold's own screening step),
 ///     and the measured held-out RMS error is compared with the fold's base model.
 ///  5. Significance rule: a candidate earns its place only if it lowers the held-out error by
 ///     at least `min_gain` in EVERY fold; the best such candidate (largest mean gain) is added,
@@ -255,6 +256,29 @@ inline bool distribute_cc_inertia(ArmDescription& d) {
   return changed;
 }
 
+/// Which screened candidates get the round's `slots` confirmation refits, in the order they
+/// are refitted. `names[r]` is candidate r's effect and `predicted[r]` its predicted gain, in
+/// screen order (predicted gain descending); candidates predicted below `min_predicted` get
+/// none. First the best-screened scope of each effect, then, while slots are left, each
+/// effect's second-best scope: distinct effects first, because "the best four, at most two
+/// scopes per effect" spent random arm 1039's four refits on two scopes each of chamber_gain
+/// and sensor_gain, and the true per-joint mass_scale, screened fifth, was never refitted.
+inline std::vector<std::size_t> confirmation_picks(const std::vector<std::string>& names,
+                                                   const std::vector<double>& predicted,
+                                                   int slots, double min_predicted) {
+  std::vector<std::size_t> picks;
+  std::vector<std::string> picked_names;
+  for (int pass = 1; pass <= 2; ++pass)
+    for (std::size_t r = 0; r < names.size() && static_cast<int>(picks.size()) < slots; ++r) {
+      if (predicted[r] < min_predicted) break;  // ordered: the rest predict less
+      const auto scopes = std::count(picked_names.begin(), picked_names.end(), names[r]);
+      if (scopes != pass - 1 || std::find(picks.begin(), picks.end(), r) != picks.end()) continue;
+      picks.push_back(r);
+      picked_names.push_back(names[r]);
+    }
+  return picks;
+}
+
 }  // namespace detail
 
 /// \brief Runs the closed loop on a training set; `test` only measures (may be null).
@@ -454,15 +478,19 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       passing.erase(std::remove(passing.begin(), passing.end(), static_cast<int>(r)), passing.end());
       if (mn >= opt.min_gain) passing.push_back(static_cast<int>(r));
     };
-    // Refit the best-screened, at most two scopes per effect.
-    std::vector<std::string> confirmed_names;
-    int refitted = 0;
-    for (std::size_t r = 0; r < scores.size() && refitted < opt.candidates_to_confirm; ++r) {
-      if (predicted(score_cand[r]) < opt.min_predicted_gain) break;  // ordered: the rest predict less
-      if (std::count(confirmed_names.begin(), confirmed_names.end(), scores[r].name) >= 2) continue;
-      confirmed_names.push_back(scores[r].name);
-      ++refitted;
-      confirm(r, {});
+    // Refit the best-screened, distinct effects first (confirmation_picks). A scope the
+    // screen ranked lower is not lost: the beside-refits below refit the shared scope of a
+    // passing narrower one and the best narrower scope of a passing shared one.
+    {
+      std::vector<std::string> names;
+      std::vector<double> gains;
+      for (std::size_t r = 0; r < scores.size(); ++r) {
+        names.push_back(scores[r].name);
+        gains.push_back(predicted(score_cand[r]));
+      }
+      for (std::size_t r : detail::confirmation_picks(names, gains, opt.candidates_to_confirm,
+                                                      opt.min_predicted_gain))
+        confirm(r, {});
     }
     // Refits candidate r beside passing candidate `from`: in each fold it starts where from's
     // refit ended, its effect replaced by r with the values start_from(the effect from's refit
@@ -528,6 +556,10 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     // refitted already (confirm keeps the better refit). The held-out gain below then
     // chooses: on a truly per-joint effect the shared scope puts the effect where it is not
     // and loses.
+    auto fitted_if_same_size = [](const AnyEffect& fitted, const Eigen::VectorXd& screen_start) {
+      const Eigen::VectorXd& p = effect_base(fitted).params;
+      return p.size() == screen_start.size() ? p : screen_start;
+    };
     const std::vector<int> passed_before_shared = passing;
     for (int narrow_index : passed_before_shared) {
       const std::size_t narrow = static_cast<std::size_t>(narrow_index);
@@ -536,11 +568,32 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       for (std::size_t r = 0; r < scores.size(); ++r) {
         const AnyEffect& o = cands[score_cand[r]].effect;
         if (scores[r].name != scores[narrow].name || effect_base(o).scope != Scope::Shared) continue;
-        confirm_beside(narrow, r, "the shared scope of",
-                       [](const AnyEffect& fitted, const Eigen::VectorXd& screen_start) {
-                         const Eigen::VectorXd& p = effect_base(fitted).params;
-                         return p.size() == screen_start.size() ? p : screen_start;
-                       });
+        confirm_beside(narrow, r, "the shared scope of", fitted_if_same_size);
+        break;
+      }
+    }
+    // The converse: a passing shared scope with no passing narrower scope of its effect has
+    // the best-screened narrower scope refitted beside it (from the shared refit's model and,
+    // one value per kind, its values), wherever the screen ranked it, so that an effect on one
+    // joint is not reported as a shared one only because its own scope got no refit (the
+    // distinct-effects-first rule above gives each effect one refit per round before a second
+    // scope). The held-out gain below chooses between them.
+    const std::vector<int> passed_before_narrow = passing;
+    auto is_passing_narrower = [&](const std::string& name) {
+      for (int p : passing)
+        if (scores[static_cast<std::size_t>(p)].name == name &&
+            effect_base(cands[score_cand[static_cast<std::size_t>(p)]].effect).scope != Scope::Shared)
+          return true;
+      return false;
+    };
+    for (int shared_index : passed_before_narrow) {
+      const std::size_t shared = static_cast<std::size_t>(shared_index);
+      if (effect_base(cands[score_cand[shared]].effect).scope != Scope::Shared) continue;
+      if (is_passing_narrower(scores[shared].name)) continue;
+      for (std::size_t r = 0; r < scores.size(); ++r) {
+        const AnyEffect& o = cands[score_cand[r]].effect;
+        if (scores[r].name != scores[shared].name || effect_base(o).scope == Scope::Shared) continue;
+        confirm_beside(shared, r, "a narrower scope of", fitted_if_same_size);
         break;
       }
     }
