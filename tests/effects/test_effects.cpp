@@ -1238,4 +1238,52 @@ TEST(RobotFile, ParameterNamesAreCheckedWhenRead) {
   expect_bad(mixed, {"mem.json", "effects[0] 'stiffening'", "field 'params'", "mixes scopes"});
 }
 
+// The joints table is the one place the springs, dampers and pressure maps live once a fit has
+// changed them: the chain built from the description carries them (not the robot file's
+// declared values), and the model's joint forces are the chain's segments' own, -K q - D qd +
+// K_prs p written out here from the table.
+TEST(ArmDynamics, JointForcesAreTheFittedJointsOfTheTable) {
+  ArmDescription d = declared();
+  for (auto& j : d.joints) {
+    j.stiffness *= 1.7;
+    j.damping *= 0.4;
+    j.pressure_to_torque *= 1.3;
+  }
+  const auto chain = d.make_chain<double>();
+  for (const auto& j : d.joints)
+    std::visit(
+        [&](const auto& seg) {
+          using Seg = std::decay_t<decltype(seg)>;
+          if constexpr (Seg::nq == 2) {
+            EXPECT_EQ(seg.stiffness, j.stiffness);
+            EXPECT_EQ(seg.damping, j.damping);
+            EXPECT_EQ(Eigen::MatrixXd(seg.pressure_to_torque), Eigen::MatrixXd(j.pressure_to_torque));
+          } else if constexpr (Seg::nq == 1) {
+            EXPECT_EQ(seg.stiffness, j.stiffness(0));
+            EXPECT_EQ(seg.damping, j.damping(0));
+          } else {
+            ADD_FAILURE() << j.name << ": a joint of the table on a segment without coordinates";
+          }
+        },
+        chain.segment(j.segment));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  VectorXd q(d.nq), qd(d.nq), p(d.num_inputs);
+  for (int i = 0; i < d.nq; ++i) { q(i) = 0.5 * u(rng); qd(i) = u(rng); }
+  for (int i = 0; i < d.num_inputs; ++i) p(i) = 2e4 * (1.0 + u(rng));
+  ArmDynamics<double> f(d);
+  const VectorXd tau = f.joint_forces(q, qd, p, VectorXd());
+  VectorXd expected(d.nq);
+  for (const auto& j : d.joints)
+    for (int k = 0; k < j.nq; ++k) {
+      double t = -j.stiffness(k) * q(j.q_offset + k) - j.damping(k) * qd(j.q_offset + k);
+      for (int c = 0; c < j.num_inputs; ++c) t += j.pressure_to_torque(k, c) * p(j.input_offset + c);
+      expected(j.q_offset + k) = t;
+    }
+  EXPECT_LT((tau - expected).cwiseAbs().maxCoeff(), 1e-12 * (1.0 + expected.cwiseAbs().maxCoeff()));
+  // The same forces from the declared values differ: the test can fail.
+  ArmDynamics<double> f0(declared());
+  EXPECT_GT((f0.joint_forces(q, qd, p, VectorXd()) - expected).cwiseAbs().maxCoeff(), 1e-3);
+}
+
 }  // namespace

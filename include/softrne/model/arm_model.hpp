@@ -20,6 +20,15 @@
 #include "softrne/io/robot_spec.hpp"
 
 namespace softrne {
+namespace detail {
+/// True for segments with pressure inputs (an `actuation(p)` member: the CC joint).
+template <class Seg, class = void>
+struct has_actuation : std::false_type {};
+template <class Seg>
+struct has_actuation<Seg, std::void_t<decltype(std::declval<const Seg&>().actuation(
+                              std::declval<Eigen::Matrix<typename Seg::Scalar, Eigen::Dynamic, 1>>()))>>
+    : std::true_type {};
+}  // namespace detail
 
 /// \brief The constant description of an arm (double precision): joint table, effects, sizes.
 /// The chain itself is built for any Scalar by `make_chain<S>()`.
@@ -134,27 +143,32 @@ struct ArmDescription {
   }
 
   /// \brief The chain: the segments of the spec with their masses and inertias scaled by any
-  /// mass_scale effect, plus a payload point mass if an effect adds one.
+  /// mass_scale effect, plus a payload point mass if an effect adds one, and the springs,
+  /// dampers and pressure maps of `joints` (the current, possibly fitted, values: the spec
+  /// holds the declared ones).
   /// \tparam S The scalar type (double, or an AutoDiff type for the Jacobian).
-  /// \return The runtime chain (its springs, dampers and pressure maps are in `joints`).
+  /// \return The runtime chain.
   template <class S>
   DynamicChain<S> make_chain() const {
     DynamicChain<S> c;
     const std::vector<double> scale = segment_mass_scale();
+    std::vector<const ArmJoint*> joint_of(spec.segments.size(), nullptr);
+    for (const auto& j : joints) joint_of[static_cast<std::size_t>(j.segment)] = &j;
     for (std::size_t s = 0; s < spec.segments.size(); ++s) {
       const auto& seg = spec.segments[s];
       if (const auto* cc = std::get_if<io::CCJointSpec>(&seg)) {
+        const ArmJoint& jt = *joint_of[s];
         ConstantCurvatureJoint<S> j;
         // A CC joint's inertia follows from its mass and geometry (eqs. 19-22), so scaling
         // the mass scales the inertia too.
         j.mass = S(cc->mass * scale[s]);
         j.height = S(cc->height);
         j.diameter = S(cc->diameter);
-        j.stiffness = cc->stiffness.cast<S>();
-        j.damping = cc->damping.cast<S>();
-        if (cc->pressure_to_torque.cols() > ConstantCurvatureJoint<S>::max_chambers)
+        j.stiffness = jt.stiffness.cast<S>();
+        j.damping = jt.damping.cast<S>();
+        if (jt.pressure_to_torque.cols() > ConstantCurvatureJoint<S>::max_chambers)
           throw std::invalid_argument("joint '" + cc->name + "': more than 8 chambers");
-        j.pressure_to_torque = cc->pressure_to_torque.cast<S>();
+        j.pressure_to_torque = jt.pressure_to_torque.cast<S>();
         if (cc->inertia_model == "distributed") {
           // The runtime chain has one distributed type, DistributedInertia<> (the default
           // number of points; build_arm rejects any other quadrature_points).
@@ -170,10 +184,11 @@ struct ArmDescription {
         l.inertia = (rl->inertia * scale[s]).cast<S>();
         c.add(l, rl->name);
       } else if (const auto* rj = std::get_if<io::RevoluteJointSpec>(&seg)) {
+        const ArmJoint& jt = *joint_of[s];
         RevoluteJoint<S> r;
         r.axis = rj->axis.cast<S>();
-        r.stiffness = S(rj->stiffness);
-        r.damping = S(rj->damping);
+        r.stiffness = S(jt.stiffness(0));
+        r.damping = S(jt.damping(0));
         c.add(r, rj->name);
       }
     }
@@ -533,16 +548,24 @@ class ArmDynamics {
   /// \param[in] p The effective pressures, Pa.
   /// \param[in] xs The effect states.
   /// \return The generalised forces (valid until the next call).
+  /// The springs, dampers and pressure maps are the chain's segments' own (passive_force,
+  /// actuation), built from the description's joints when this object was made.
   template <class Q, class Qd, class P, class X>
   const VectorS& joint_forces(const Q& q, const Qd& qd, const P& p, const X& xs) {
     const auto& d = *desc_;
     for (const auto& j : d.joints) {
-      for (int k = 0; k < j.nq; ++k) {
-        S t = -(S(j.stiffness(k)) * q(j.q_offset + k) + S(j.damping(k)) * qd(j.q_offset + k));
-        for (int c = 0; c < j.num_inputs; ++c)
-          t += S(j.pressure_to_torque(k, c)) * p(j.input_offset + c);
-        tau_(j.q_offset + k) = t;
-      }
+      std::visit(
+          [&](const auto& seg) {
+            using Seg = std::decay_t<decltype(seg)>;
+            constexpr int n = Seg::nq;
+            if constexpr (n > 0) {
+              auto t = tau_.template segment<n>(j.q_offset);
+              t = seg.passive_force(q.template segment<n>(j.q_offset), qd.template segment<n>(j.q_offset));
+              if constexpr (detail::has_actuation<Seg>::value)
+                t += seg.actuation(p.segment(j.input_offset, seg.num_inputs()));
+            }
+          },
+          chain_.segment(j.segment));
     }
     for (std::size_t k = 0; k < d.effects.size(); ++k)
       std::visit(
