@@ -12,7 +12,7 @@
 #    writes $BUILD_DIR/srl/results.md.
 # The data is read from ../shared/data/real/srl-3d-soft-trunk (relative to the repository) or
 # $SRL_DATA; when it is absent the script says so and exits 0 without doing anything.
-# Environment: BUILD_DIR, JOBS (default 2), SRL_DATA, PYTHON (default python3),
+# Environment: BUILD_DIR, JOBS (default 2), SRL_DATA, PYTHON (default: the first python3 with numpy and scipy),
 # SRL_TRAIN (default MPC_logger_ts1), SRL_TEST (default MPC_logger_ts2),
 # SRL_MORE_TESTS (default "MPC_logger_ts3 MPC_logger_tube1 MPC_logger_tube2 MPC_logger_tube3").
 set -euo pipefail
@@ -21,7 +21,21 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 data=${SRL_DATA:-../shared/data/real/srl-3d-soft-trunk}
 build_dir=${BUILD_DIR:-build-real}
 jobs=${JOBS:-2}
-py=${PYTHON:-python3}
+# The importer needs numpy and scipy: take $PYTHON, else the first of python3, /usr/bin/python3
+# that has both (as run-main.sh searches for numpy and matplotlib).
+py=${PYTHON:-}
+if [[ -z "$py" ]]; then
+  for candidate in python3 /usr/bin/python3; do
+    if "$candidate" -c 'import numpy, scipy' 2>/dev/null; then py=$candidate; break; fi
+  done
+  if [[ -z "$py" ]]; then
+    echo "[run-real-data] error: no python3 with numpy and scipy (tools/install-deps.sh --python, or set PYTHON)" >&2
+    exit 2
+  fi
+elif ! "$py" -c 'import numpy, scipy' 2>/dev/null; then
+  echo "[run-real-data] error: PYTHON=$py lacks numpy or scipy" >&2
+  exit 2
+fi
 train=${SRL_TRAIN:-MPC_logger_ts1}
 test=${SRL_TEST:-MPC_logger_ts2}
 more_tests=${SRL_MORE_TESTS:-MPC_logger_ts3 MPC_logger_tube1 MPC_logger_tube2 MPC_logger_tube3}
