@@ -546,16 +546,6 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
         break;
       }
     }
-    // A passing effect in a narrower scope (per joint, coordinate or chamber) has its shared
-    // scope refitted too, wherever the screen ranked it: the joint that carries most of a
-    // shared effect's signal dominates the screen's linearised gains, so two narrower scopes
-    // on that joint could take the effect's two refits (random arms 1029 and 1034: actuator
-    // lag and pressure stiffening on both joints, reported on one). It starts in each fold
-    // from the narrower refit's model, with the narrower refit's values when those are one
-    // per kind (one joint), else the screen's; also when the screen had the shared scope
-    // refitted already (confirm keeps the better refit). The held-out gain below then
-    // chooses: on a truly per-joint effect the shared scope puts the effect where it is not
-    // and loses.
     auto fitted_if_same_size = [](const AnyEffect& fitted, const Eigen::VectorXd& screen_start) {
       const Eigen::VectorXd& p = effect_base(fitted).params;
       return p.size() == screen_start.size() ? p : screen_start;
@@ -590,6 +580,16 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
         break;
       }
     }
+    // A passing effect in a narrower scope (per joint, coordinate or chamber) has its shared
+    // scope refitted too, wherever the screen ranked it: the joint that carries most of a
+    // shared effect's signal dominates the screen's linearised gains, so two narrower scopes
+    // on that joint could take the effect's two refits (random arms 1029 and 1034: actuator
+    // lag and pressure stiffening on both joints, reported on one). It starts in each fold
+    // from the narrower refit's model, with the narrower refit's values when those are one
+    // per kind (one joint), else the screen's; also when the screen had the shared scope
+    // refitted already (confirm keeps the better refit). The held-out gain below then
+    // chooses: on a truly per-joint effect the shared scope puts the effect where it is not
+    // and loses.
     const std::vector<int> passed_before_shared = passing;
     for (int narrow_index : passed_before_shared) {
       const std::size_t narrow = static_cast<std::size_t>(narrow_index);
