@@ -147,6 +147,11 @@ inline std::string format_double(double v) {
   return std::string(buf, r.ptr);
 }
 
+/// \brief "<where>: field '<field>'".
+inline std::string field_where(const std::string& where, const std::string& field) {
+  return where.empty() ? "field '" + field + "'" : where + ": field '" + field + "'";
+}
+
 }  // namespace detail
 
 /// \brief A file that softrne cannot use, and why.

@@ -40,11 +40,6 @@ inline std::string effect_where(const std::string& prefix, std::size_t index,
   return w;
 }
 
-/// \brief "<where>: field '<field>'".
-inline std::string field_where(const std::string& where, const std::string& field) {
-  return where.empty() ? "field '" + field + "'" : where + ": field '" + field + "'";
-}
-
 /// \brief Checks of one number of the description.
 struct NumberCheck {
   const std::string& source;
