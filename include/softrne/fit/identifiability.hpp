@@ -17,6 +17,7 @@
 #include <Eigen/SVD>
 
 #include "softrne/config.hpp"
+#include "softrne/fit/finite_difference_jacobian.hpp"
 #include "softrne/fit/least_squares_types.hpp"
 #include "softrne/fit/parameters.hpp"
 #include "softrne/fit/residual_evaluation.hpp"
@@ -43,27 +44,9 @@ SOFTRNE_FIT_INLINE void identifiability(const ParameterSet& ps, Runner& runner, 
   Eigen::MatrixXd J(m, p);
   std::vector<char> column_ok(static_cast<std::size_t>(p), 0);
   runner.run(p, [&](int k, Evaluator& ev) {
-    const double h = h_rel * magnitude[k];
-    Eigen::VectorXd v = x, r_plus, r_minus;
-    const double up = x[k] + h, down = x[k] - h;
-    bool a = false, b = false;
-    if (up <= hi[k]) {
-      v[k] = up;
-      a = ev.physical(v, r_plus);
-    }
-    if (down >= lo[k]) {
-      v[k] = down;
-      b = ev.physical(v, r_minus);
-    }
-    bool ok = true;
-    if (a && b)
-      J.col(k) = (r_plus - r_minus) / (up - down);
-    else if (a)
-      J.col(k) = (r_plus - r) / (up - x[k]);
-    else if (b)
-      J.col(k) = (r - r_minus) / (x[k] - down);
-    else
-      ok = false;
+    Eigen::VectorXd v = x;
+    const bool ok = central_difference_column(ev, Coordinates::physical, x, r, k,
+                                              h_rel * magnitude[k], lo[k], hi[k], v, J.col(k));
     if (!ok) J.col(k).setZero();
     column_ok[k] = ok ? 1 : 0;
   });
