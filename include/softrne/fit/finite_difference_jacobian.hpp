@@ -2,7 +2,8 @@
 /// \file
 /// \brief Finite-difference Jacobian of the residual: forward or central differences, each
 ///        step kept inside the parameter box, the other side tried when an evaluation fails,
-///        the columns evaluated in parallel.
+///        the columns evaluated in parallel. Its central difference is also the one of the
+///        identifiability analysis.
 
 #include <cstddef>
 #include <vector>
