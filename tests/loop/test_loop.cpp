@@ -3,6 +3,8 @@
 // its scope, leave effect-free data alone, and never make the held-out error worse.
 #include <gtest/gtest.h>
 
+#include <ostream>
+
 #include "softrne/fit/loop.hpp"
 #include "../fit/synthetic_arm.hpp"
 
@@ -23,6 +25,9 @@ struct Case {
   unsigned seed;
   bool distributed_truth = false;  ///< data from distributed-inertia CC joints, declared lumped
 };
+
+// The case's label in ctest's and gtest's lines (the default prints the object's bytes).
+void PrintTo(const Case& c, std::ostream* os) { *os << c.label; }
 
 ArmDescription truth_of(const ArmDescription& declared, const Case& c) {
   ArmDescription d = declared;
