@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "softrne/segments/constant_curvature_joint.hpp"
+#include "autodiff_reference.hpp"
 #include "support.hpp"
 
 namespace {

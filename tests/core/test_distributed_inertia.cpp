@@ -13,6 +13,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "softrne/softrne.hpp"
+#include "autodiff_reference.hpp"
 #include "support.hpp"
 
 namespace {
@@ -290,61 +291,8 @@ TEST(DistributedInertiaAutoDiff, InTheReleaseTestsOnly) {
 
 // ---------------------------------------------------------------------------------------
 // Euler-Lagrange of the quadrature disks' energy (plus the lumped bodies of the other
-// segments), differentiated with AutoDiff (as tests/core/test_rnea.cpp does for the lumped
-// chain). Velocities are propagated in the world frame by this helper, not by the RNE.
-template <class ChainT, class QV>
-void energies(const ChainT& chain, const QV& q, const QV& qd, typename ChainT::Scalar& T,
-              typename ChainT::Scalar& V) {
-  using S = typename ChainT::Scalar;
-  using V3 = Eigen::Matrix<S, 3, 1>;
-  using M3 = Eigen::Matrix<S, 3, 3>;
-  auto data = chain.make_data();
-  compute_kinematics(chain, data, q, qd);
-  M3 R = M3::Identity();
-  V3 p = V3::Zero(), v = V3::Zero(), w = V3::Zero();
-  T = S(0);
-  V = S(0);
-  chain.forward(data, [&](const auto& seg, const auto& kin, int, int off) {
-    using Seg = std::decay_t<decltype(seg)>;
-    constexpr int n = Seg::nq;
-    V3 v_rel = V3::Zero(), w_rel = V3::Zero();
-    if constexpr (n > 0) {
-      const auto qds = qd.template segment<n>(off);
-      v_rel = kin.J_distal.template topRows<3>() * qds;
-      w_rel = kin.J_distal.template bottomRows<3>() * qds;
-      if constexpr (detail::num_sub_bodies<Seg> > 0) {
-        for (const auto& b : kin.sub_bodies) {
-          const V3 vb = v + w.cross(R * b.r_base_body) + R * (b.J_v * qds);
-          const V3 wb = w + R * (b.J_w * qds);
-          const M3 Ib = R * b.inertia * R.transpose();
-          T += S(0.5) * b.mass * vb.squaredNorm() + S(0.5) * wb.dot(Ib * wb);
-          V -= b.mass * chain.gravity.dot(p + R * b.r_base_body);
-        }
-      } else if constexpr (Seg::has_body) {
-        const V3 vc = v + w.cross(R * kin.r_base_com) + R * (kin.J_com * qds);
-        const V3 wb = (R * kin.R_base_distal).transpose() * (w + R * w_rel);
-        T += S(0.5) * seg.mass * vc.squaredNorm() + S(0.5) * wb.dot(kin.inertia_com * wb);
-        V -= seg.mass * chain.gravity.dot(p + R * kin.r_base_com);
-      }
-    } else if constexpr (Seg::has_body) {
-      const V3 vc = v + w.cross(R * kin.r_base_com);
-      const V3 wb = (R * kin.R_base_distal).transpose() * w;
-      T += S(0.5) * seg.mass * vc.squaredNorm() + S(0.5) * wb.dot(kin.inertia_com * wb);
-      V -= seg.mass * chain.gravity.dot(p + R * kin.r_base_com);
-    }
-    v = v + w.cross(R * kin.r_base_distal) + R * v_rel;
-    p = p + R * kin.r_base_distal;
-    w = w + R * w_rel;
-    R = R * kin.R_base_distal;
-  });
-}
-
-#if SOFTRNE_TEST_AUTODIFF_REFERENCES
-// The energies above as one object, for the references of support.hpp.
-constexpr auto kEnergies = [](const auto& chain, const auto& q, const auto& qd, auto& T, auto& V) {
-  energies(chain, q, qd, T, V);
-};
-#endif
+// segments), differentiated with AutoDiff (autodiff_reference.hpp, as tests/core/test_rnea.cpp
+// does for the lumped chain).
 
 // Distributed CC joints mixed with links, a revolute joint and a lumped CC joint.
 DynamicChain<double> mixed() {
@@ -371,26 +319,7 @@ DynamicChain<double> dist_only() {
 }
 
 #if SOFTRNE_TEST_AUTODIFF_REFERENCES
-void check_against_lagrangian(const DynamicChain<double>& chain, int states, double q_scale,
-                              unsigned seed) {
-  const auto chain_ad = chain.cast<softrne_test::ADL>();
-  auto data = chain.make_data();
-  std::mt19937 rng(seed);
-  const int n = chain.num_coordinates();
-  double worst = 0;
-  for (int s = 0; s < states; ++s) {
-    const VectorXd q = softrne_test::random_vector(rng, n, q_scale);
-    const VectorXd qd = softrne_test::random_vector(rng, n, 2.0);
-    const VectorXd qdd = softrne_test::random_vector(rng, n, 5.0);
-    const VectorXd tau = rnea(chain, data, q, qd, qdd);
-    const VectorXd ref = softrne_test::euler_lagrange(kEnergies, chain_ad, q, qd, qdd);
-    const double e = (tau - ref).norm() / std::max(1e-3, ref.norm());
-    worst = std::max(worst, e);
-    ASSERT_LT(e, 1e-9) << "state " << s << "\nrnea " << tau.transpose() << "\nEL   " << ref.transpose();
-  }
-  std::printf("[ info ] %d coordinates: worst relative |rnea - Euler-Lagrange| = %.2e\n", n, worst);
-}
-
+using softrne_test::check_against_lagrangian;
 TEST(DistributedLagrangian, DistributedOnly) { check_against_lagrangian(dist_only(), 40, 1.6, 41); }
 TEST(DistributedLagrangian, MixedChain) { check_against_lagrangian(mixed(), 40, 1.6, 42); }
 #else
@@ -507,7 +436,7 @@ TEST(DistributedEnergy, FreeMotionConservesEnergy) {
   auto data = arm.make_data();
   auto energy = [&](const VQ& q, const VQ& qd) {
     double T, V;
-    energies(arm, q, qd, T, V);
+    softrne_test::energies(arm, q, qd, T, V);
     return T + V + 0.5 * q.dot(k.cwiseProduct(q));
   };
   auto accel = [&](const VQ& q, const VQ& qd) {
@@ -517,7 +446,7 @@ TEST(DistributedEnergy, FreeMotionConservesEnergy) {
   VQ q = (VQ() << 0.9, -0.6, 1.2, 0.4).finished(), qd = (VQ() << 0.0, 2.0, -3.0, 1.0).finished();
   const double E0 = energy(q, qd);
   double T0, V0;
-  energies(arm, q, qd, T0, V0);
+  softrne_test::energies(arm, q, qd, T0, V0);
   const double dt = 2e-4;
   double drift = 0, max_speed = 0;
   for (int step = 0; step < 15000; ++step) {  // 3 s, RK4
@@ -534,7 +463,7 @@ TEST(DistributedEnergy, FreeMotionConservesEnergy) {
   }
   // T from the disks equals 1/2 qd^T M qd.
   double T, V;
-  energies(arm, q, qd, T, V);
+  softrne_test::energies(arm, q, qd, T, V);
   EXPECT_LT(std::abs(T - 0.5 * qd.dot(mass_matrix(arm, data, q) * qd)), 1e-13 * std::max(1.0, T));
   std::printf("[ info ] 3 s free motion (max |qd| %.2f rad/s, T0 %.3f J): max |E - E0| = %.2e J\n",
               max_speed, T0, drift);
