@@ -1,7 +1,7 @@
 // The distributed-inertia CC joint (ConstantCurvatureJoint<S, DistributedInertia<NG>>): closed
 // form at q = 0, convergence of M, C qdot, G to the continuum of thin disks (an independent
 // 2,000-disk midpoint sum with its own kinematics), Euler-Lagrange of the quadrature disks'
-// energy on mixed chains (AutoDiff), energy conservation, static == runtime chain, identities
+// energy on mixed chains (AutoDiff, autodiff_reference.hpp), energy conservation, static == runtime chain, identities
 // between the algorithms, the own-body inertia that the articulated-body algorithm uses.
 #include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
 #include <gtest/gtest.h>
@@ -226,14 +226,11 @@ TEST(DistributedInertia, ConvergenceToContinuum) {
 }
 
 // ---------------------------------------------------------------------------------------
-#if SOFTRNE_TEST_AUTODIFF_REFERENCES
-// The disks' Jacobians and their rates against AutoDiff of their poses.
-TEST(DistributedInertia, DiskJacobiansMatchAutoDiff) {
-  // One AutoDiff pass: directions 0 and 1 are d/dq, direction 2 is d/dt along q + t qd (the
-  // rates). ADL is the type the Lagrangian tests below instantiate the joint with anyway.
-  using ADT = softrne_test::ADL;
+// The disks' inertia is eq. 20 (D^2/16 (1, 1, 2) in the disk's frame, times its mass) rotated
+// with the disk. Their Jacobians and rates against AutoDiff and finite differences:
+// tests/segments/test_segment_conformance.cpp.
+TEST(DistributedInertia, DiskInertiaIsEquation20) {
   const auto j = dist_cc<double>();
-  const auto ja = j.cast<ADT>();
   std::mt19937 rng(3);
   double worst = 0;
   for (int trial = 0; trial < 50; ++trial) {
@@ -241,53 +238,14 @@ TEST(DistributedInertia, DiskJacobiansMatchAutoDiff) {
     const Eigen::Vector2d qd = softrne_test::random_vector(rng, 2, 2.0);
     decltype(j)::Kinematics k;
     j.calc(q, qd, k);
-    Eigen::Matrix<ADT, 2, 1> qa, qda;
-    for (int i = 0; i < 2; ++i) {
-      qa(i).value() = q(i);
-      qa(i).derivatives().setZero();
-      qa(i).derivatives()(i) = 1.0;
-      qa(i).derivatives()(2) = qd(i);
-      qda(i).value() = qd(i);
-      qda(i).derivatives().setZero();
-    }
-    typename decltype(ja)::Kinematics ka;
-    ja.calc(qa, qda, ka);
-    for (int b = 0; b < kDefaultGaussPoints; ++b) {
-      const auto& B = k.sub_bodies[static_cast<std::size_t>(b)];
-      const auto& Ba = ka.sub_bodies[static_cast<std::size_t>(b)];
-      Matrix3d R;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) R(r, c) = Ba.R_base_body(r, c).value();
-      for (int col = 0; col < 2; ++col) {
-        Vector3d dr;
-        Matrix3d dR;
-        for (int r = 0; r < 3; ++r) {
-          dr(r) = Ba.r_base_body(r).derivatives()(col);
-          for (int c = 0; c < 3; ++c) dR(r, c) = Ba.R_base_body(r, c).derivatives()(col);
-        }
-        worst = std::max(worst, (B.J_v.col(col) - dr).norm());
-        worst = std::max(worst, (B.J_w.col(col) - vee_skew(dR * R.transpose())).norm());
-      }
-      Vector3d av, aw;
-      for (int r = 0; r < 3; ++r) {
-        av(r) = (Ba.J_v.row(r) * qda).value().derivatives()(2);
-        aw(r) = (Ba.J_w.row(r) * qda).value().derivatives()(2);
-      }
-      worst = std::max(worst, (B.Jdot_qdot_v - av).norm());
-      worst = std::max(worst, (B.Jdot_qdot_w - aw).norm());
-      // Eq. 20 inertia, rotated.
+    for (const auto& B : k.sub_bodies) {
+      const Matrix3d& R = B.R_base_body;
       const Matrix3d Ib = R * Vector3d(1, 1, 2).asDiagonal() * R.transpose() * B.mass * 0.04 / 16;
       worst = std::max(worst, (B.inertia - Ib).norm() / Ib.norm());
     }
   }
-  std::printf("[ info ] disk Jacobians and rates vs AutoDiff: worst %.2e\n", worst);
   EXPECT_LT(worst, 1e-13);
 }
-#else
-TEST(DistributedInertiaAutoDiff, InTheReleaseTestsOnly) {
-  GTEST_SKIP() << "AutoDiff references are not built here (SOFTRNE_TEST_AUTODIFF_REFERENCES=OFF)";
-}
-#endif
 
 // ---------------------------------------------------------------------------------------
 // Euler-Lagrange of the quadrature disks' energy (plus the lumped bodies of the other
