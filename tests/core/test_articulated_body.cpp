@@ -16,6 +16,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "softrne/softrne.hpp"
+#include "autodiff_reference.hpp"
 #include "support.hpp"
 
 namespace {

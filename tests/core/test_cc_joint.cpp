@@ -1,6 +1,8 @@
 // ConstantCurvatureJoint against references that share none of its code: the arc integrated
 // as an ODE along its length, direct sums over thin disks (paper eq. 22 with the parallel-axis
-// theorem applied here), central finite differences and Eigen AutoDiff.
+// theorem applied here), closed forms. Its Jacobians and rates against AutoDiff and finite
+// differences, its scalar casts and calc's allocations are checked with every other segment
+// type in tests/segments/test_segment_conformance.cpp.
 #include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
 #include <gtest/gtest.h>
 
@@ -13,7 +15,6 @@
 namespace {
 
 using softrne::ConstantCurvatureJoint;
-using softrne_test::AD;
 using Joint = ConstantCurvatureJoint<double>;
 using Kin = Joint::Kinematics;
 using Eigen::Matrix3d;
@@ -141,122 +142,6 @@ TEST(ConstantCurvatureJoint, StraightJointMassMatrixTermClosedForm) {
   EXPECT_NEAR(Muu, j.mass * (h * h / 9 + D * D / 16), 1e-15);
 }
 
-// Pose as (p, R) under AutoDiff, for derivative references.
-struct AdKin {
-  Eigen::Matrix<AD, 3, 3> R;
-  Eigen::Matrix<AD, 3, 1> re, rc;
-  Eigen::Matrix<AD, 3, 3> I;
-};
-
-AdKin calc_ad(const Joint& j, const Eigen::Matrix<AD, 2, 1>& q) {
-  const auto ja = j.cast<AD>();
-  ConstantCurvatureJoint<AD>::Kinematics k;
-  Eigen::Matrix<AD, 2, 1> qd;
-  qd.setZero();
-  ja.calc(q, qd, k);
-  return {k.R_base_distal, k.r_base_distal, k.r_base_com, k.inertia_com};
-}
-
-Vector3d vee(const Matrix3d& W) { return Vector3d(W(2, 1), W(0, 2), W(1, 0)); }
-
-// Checks J, dI/dq against AutoDiff of the positions, rotation and inertia, and Jdot qdot
-// against the AutoDiff time derivative of J(q + t qdot) qdot.
-void check_derivatives(const Joint& j, const Vector2d& q, const Vector2d& qd, double tol,
-                       double* worst = nullptr) {
-  const Kin k = calc(j, q, qd);
-  Eigen::Matrix<AD, 2, 1> qa;
-  qa(0) = AD(q(0), 2, 0);
-  qa(1) = AD(q(1), 2, 1);
-  const AdKin a = calc_ad(j, qa);
-  Eigen::Matrix<double, 6, 2> J_ref;
-  Eigen::Matrix<double, 3, 2> Jc_ref;
-  Matrix3d R;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) R(r, c) = a.R(r, c).value();
-  for (int col = 0; col < 2; ++col) {
-    Matrix3d dR, dI;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) {
-        dR(r, c) = a.R(r, c).derivatives()(col);
-        dI(r, c) = a.I(r, c).derivatives()(col);
-      }
-    for (int r = 0; r < 3; ++r) {
-      J_ref(r, col) = a.re(r).derivatives()(col);
-      Jc_ref(r, col) = a.rc(r).derivatives()(col);
-    }
-    J_ref.block<3, 1>(3, col) = vee(dR * R.transpose());
-    const double e = (k.dinertia_dq[static_cast<std::size_t>(col)] - dI).norm() /
-                     std::max(1e-300, k.inertia_com.norm());
-    EXPECT_LT(e, tol) << "dI/dq" << col << " at " << q.transpose();
-    if (worst) *worst = std::max(*worst, e);
-  }
-  const double eJ = (k.J_distal - J_ref).norm() / std::max(1.0, J_ref.norm());
-  const double eJc = (k.J_com - Jc_ref).norm() / std::max(1.0, Jc_ref.norm());
-  EXPECT_LT(eJ, tol) << "J_distal at " << q.transpose();
-  EXPECT_LT(eJc, tol) << "J_com at " << q.transpose();
-
-  // d/dt [J(q + t qd) qd] at t = 0, by AutoDiff in t.
-  const auto ja = j.cast<AD>();
-  ConstantCurvatureJoint<AD>::Kinematics kt;
-  Eigen::Matrix<AD, 2, 1> qt, qdt;
-  for (int i = 0; i < 2; ++i) {
-    qt(i) = AD(q(i), Eigen::VectorXd::Constant(1, qd(i)));
-    qdt(i) = AD(qd(i), Eigen::VectorXd::Zero(1));
-  }
-  ja.calc(qt, qdt, kt);
-  Eigen::Matrix<double, 6, 1> Jdot_ref;
-  Eigen::Matrix<double, 3, 1> Jdotc_ref;
-  for (int r = 0; r < 6; ++r) {
-    AD s = kt.J_distal(r, 0) * qdt(0) + kt.J_distal(r, 1) * qdt(1);
-    Jdot_ref(r) = s.derivatives().size() ? s.derivatives()(0) : 0.0;
-  }
-  for (int r = 0; r < 3; ++r) {
-    AD s = kt.J_com(r, 0) * qdt(0) + kt.J_com(r, 1) * qdt(1);
-    Jdotc_ref(r) = s.derivatives().size() ? s.derivatives()(0) : 0.0;
-  }
-  const double scale = std::max(1.0, qd.squaredNorm());
-  EXPECT_LT((k.Jdot_qdot_distal - Jdot_ref).norm() / scale, tol) << "Jdot at " << q.transpose();
-  EXPECT_LT((k.Jdot_qdot_com - Jdotc_ref).norm() / scale, tol) << "Jdot_com at " << q.transpose();
-  if (worst) *worst = std::max({*worst, eJ, eJc});
-}
-
-TEST(ConstantCurvatureJoint, JacobiansMatchAutoDiff) {
-  const Joint j = joint();
-  std::mt19937 rng(4);
-  double worst = 0;
-  for (int i = 0; i < 200; ++i) {
-    const Vector2d q = softrne_test::random_vector(rng, 2, 2.5);
-    const Vector2d qd = softrne_test::random_vector(rng, 2, 3.0);
-    check_derivatives(j, q, qd, 1e-12, &worst);
-  }
-  std::printf("[ info ] worst relative Jacobian/dI error vs AutoDiff: %.2e\n", worst);
-}
-
-TEST(ConstantCurvatureJoint, JacobiansMatchCentralDifferences) {
-  const Joint j = joint();
-  std::mt19937 rng(5);
-  for (int i = 0; i < 50; ++i) {
-    const Vector2d q = softrne_test::random_vector(rng, 2, 2.5);
-    const Vector2d qd = softrne_test::random_vector(rng, 2, 3.0);
-    const Kin k = calc(j, q, qd);
-    const double eps = 1e-6;
-    // J qdot must equal the numerically differentiated pose along qdot.
-    const Kin kp = calc(j, q + eps * qd), km = calc(j, q - eps * qd);
-    const Vector3d v_fd = (kp.r_base_distal - km.r_base_distal) / (2 * eps);
-    const Vector3d w_fd = vee((kp.R_base_distal - km.R_base_distal) / (2 * eps) * k.R_base_distal.transpose());
-    const Vector3d vc_fd = (kp.r_base_com - km.r_base_com) / (2 * eps);
-    EXPECT_LT((k.J_distal.topRows<3>() * qd - v_fd).norm(), 1e-7 * std::max(1.0, v_fd.norm()));
-    EXPECT_LT((k.J_distal.bottomRows<3>() * qd - w_fd).norm(), 1e-7 * std::max(1.0, w_fd.norm()));
-    EXPECT_LT((k.J_com * qd - vc_fd).norm(), 1e-7 * std::max(1.0, vc_fd.norm()));
-    // d/dt (J qdot) at fixed qdot equals Jdot qdot.
-    const Kin kp2 = calc(j, q + eps * qd, qd), km2 = calc(j, q - eps * qd, qd);
-    const Eigen::Matrix<double, 6, 1> dJ = (kp2.J_distal * qd - km2.J_distal * qd) / (2 * eps);
-    EXPECT_LT((k.Jdot_qdot_distal - dJ).norm(), 1e-7 * std::max(1.0, dJ.norm()));
-    const Matrix3d dI = (kp.inertia_com - km.inertia_com) / (2 * eps);
-    EXPECT_LT((k.inertia_rate - dI).norm(), 1e-7 * std::max(1e-3, dI.norm()));
-  }
-}
-
 TEST(ConstantCurvatureJoint, NearSingularConfigurations) {
   const Joint j = joint();
   const double sw = std::sqrt(softrne::detail::kCCSeriesSwitch);
@@ -278,7 +163,7 @@ TEST(ConstantCurvatureJoint, NearSingularConfigurations) {
       EXPECT_LT((k.R_base_distal - R).norm(), 1e-12) << phi;
       EXPECT_TRUE(k.J_distal.allFinite() && k.Jdot_qdot_distal.allFinite() && k.J_com.allFinite() &&
                   k.inertia_com.allFinite() && k.dinertia_dq[0].allFinite());
-      check_derivatives(j, q, qd, 1e-12);
+      // The derivatives at these angles: tests/segments/test_segment_conformance.cpp.
     }
   }
 }
@@ -308,34 +193,6 @@ TEST(ConstantCurvatureJoint, SwitchPointsAreContinuous) {
       EXPECT_LT(rel(a.dinertia_dq[1], b.dinertia_dq[1]), 1e-12);
     }
   }
-}
-
-TEST(ConstantCurvatureJoint, LongDoubleAgreesWithDouble) {
-  const Joint j = joint();
-  const auto jl = j.cast<long double>();
-  std::mt19937 rng(6);
-  for (int i = 0; i < 50; ++i) {
-    const Vector2d q = softrne_test::random_vector(rng, 2, 2.5), qd = softrne_test::random_vector(rng, 2, 2);
-    const Kin k = calc(j, q, qd);
-    ConstantCurvatureJoint<long double>::Kinematics kl;
-    jl.calc(q.cast<long double>(), qd.cast<long double>(), kl);
-    EXPECT_LT((k.J_distal - kl.J_distal.cast<double>()).norm(), 1e-14);
-    EXPECT_LT((k.inertia_com - kl.inertia_com.cast<double>()).norm(), 1e-15);
-    EXPECT_LT((k.Jdot_qdot_distal - kl.Jdot_qdot_distal.cast<double>()).norm(), 1e-13);
-  }
-}
-
-TEST(ConstantCurvatureJoint, CalcDoesNotAllocate) {
-  const Joint j = joint();
-  Kin k;
-  const Vector2d q(0.3, -0.4), qd(1.0, 2.0);
-  const long eigen_failures_before = softrne_test::eigen_assert_failures;
-  Eigen::internal::set_is_malloc_allowed(false);
-  j.calc(q, qd, k);
-  j.calc(Vector2d(1.5, 0.2), qd, k);
-  Eigen::internal::set_is_malloc_allowed(true);
-  EXPECT_EQ(softrne_test::eigen_assert_failures, eigen_failures_before)
-      << "heap allocation where forbidden";
 }
 
 TEST(ConstantCurvatureJoint, PressureMapIsEquation24) {

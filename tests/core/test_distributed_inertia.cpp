@@ -1,7 +1,7 @@
 // The distributed-inertia CC joint (ConstantCurvatureJoint<S, DistributedInertia<NG>>): closed
 // form at q = 0, convergence of M, C qdot, G to the continuum of thin disks (an independent
 // 2,000-disk midpoint sum with its own kinematics), Euler-Lagrange of the quadrature disks'
-// energy on mixed chains (AutoDiff), energy conservation, static == runtime chain, identities
+// energy on mixed chains (AutoDiff, autodiff_reference.hpp), energy conservation, static == runtime chain, identities
 // between the algorithms, the own-body inertia that the articulated-body algorithm uses.
 #include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
 #include <gtest/gtest.h>
@@ -13,6 +13,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "softrne/softrne.hpp"
+#include "autodiff_reference.hpp"
 #include "support.hpp"
 
 namespace {
@@ -225,14 +226,11 @@ TEST(DistributedInertia, ConvergenceToContinuum) {
 }
 
 // ---------------------------------------------------------------------------------------
-#if SOFTRNE_TEST_AUTODIFF_REFERENCES
-// The disks' Jacobians and their rates against AutoDiff of their poses.
-TEST(DistributedInertia, DiskJacobiansMatchAutoDiff) {
-  // One AutoDiff pass: directions 0 and 1 are d/dq, direction 2 is d/dt along q + t qd (the
-  // rates). ADL is the type the Lagrangian tests below instantiate the joint with anyway.
-  using ADT = softrne_test::ADL;
+// The disks' inertia is eq. 20 (D^2/16 (1, 1, 2) in the disk's frame, times its mass) rotated
+// with the disk. Their Jacobians and rates against AutoDiff and finite differences:
+// tests/segments/test_segment_conformance.cpp.
+TEST(DistributedInertia, DiskInertiaIsEquation20) {
   const auto j = dist_cc<double>();
-  const auto ja = j.cast<ADT>();
   std::mt19937 rng(3);
   double worst = 0;
   for (int trial = 0; trial < 50; ++trial) {
@@ -240,111 +238,19 @@ TEST(DistributedInertia, DiskJacobiansMatchAutoDiff) {
     const Eigen::Vector2d qd = softrne_test::random_vector(rng, 2, 2.0);
     decltype(j)::Kinematics k;
     j.calc(q, qd, k);
-    Eigen::Matrix<ADT, 2, 1> qa, qda;
-    for (int i = 0; i < 2; ++i) {
-      qa(i).value() = q(i);
-      qa(i).derivatives().setZero();
-      qa(i).derivatives()(i) = 1.0;
-      qa(i).derivatives()(2) = qd(i);
-      qda(i).value() = qd(i);
-      qda(i).derivatives().setZero();
-    }
-    typename decltype(ja)::Kinematics ka;
-    ja.calc(qa, qda, ka);
-    for (int b = 0; b < kDefaultGaussPoints; ++b) {
-      const auto& B = k.sub_bodies[static_cast<std::size_t>(b)];
-      const auto& Ba = ka.sub_bodies[static_cast<std::size_t>(b)];
-      Matrix3d R;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) R(r, c) = Ba.R_base_body(r, c).value();
-      for (int col = 0; col < 2; ++col) {
-        Vector3d dr;
-        Matrix3d dR;
-        for (int r = 0; r < 3; ++r) {
-          dr(r) = Ba.r_base_body(r).derivatives()(col);
-          for (int c = 0; c < 3; ++c) dR(r, c) = Ba.R_base_body(r, c).derivatives()(col);
-        }
-        worst = std::max(worst, (B.J_v.col(col) - dr).norm());
-        worst = std::max(worst, (B.J_w.col(col) - vee_skew(dR * R.transpose())).norm());
-      }
-      Vector3d av, aw;
-      for (int r = 0; r < 3; ++r) {
-        av(r) = (Ba.J_v.row(r) * qda).value().derivatives()(2);
-        aw(r) = (Ba.J_w.row(r) * qda).value().derivatives()(2);
-      }
-      worst = std::max(worst, (B.Jdot_qdot_v - av).norm());
-      worst = std::max(worst, (B.Jdot_qdot_w - aw).norm());
-      // Eq. 20 inertia, rotated.
+    for (const auto& B : k.sub_bodies) {
+      const Matrix3d& R = B.R_base_body;
       const Matrix3d Ib = R * Vector3d(1, 1, 2).asDiagonal() * R.transpose() * B.mass * 0.04 / 16;
       worst = std::max(worst, (B.inertia - Ib).norm() / Ib.norm());
     }
   }
-  std::printf("[ info ] disk Jacobians and rates vs AutoDiff: worst %.2e\n", worst);
   EXPECT_LT(worst, 1e-13);
 }
-#else
-TEST(DistributedInertiaAutoDiff, InTheReleaseTestsOnly) {
-  GTEST_SKIP() << "AutoDiff references are not built here (SOFTRNE_TEST_AUTODIFF_REFERENCES=OFF)";
-}
-#endif
 
 // ---------------------------------------------------------------------------------------
 // Euler-Lagrange of the quadrature disks' energy (plus the lumped bodies of the other
-// segments), differentiated with AutoDiff (as tests/core/test_rnea.cpp does for the lumped
-// chain). Velocities are propagated in the world frame by this helper, not by the RNE.
-template <class ChainT, class QV>
-void energies(const ChainT& chain, const QV& q, const QV& qd, typename ChainT::Scalar& T,
-              typename ChainT::Scalar& V) {
-  using S = typename ChainT::Scalar;
-  using V3 = Eigen::Matrix<S, 3, 1>;
-  using M3 = Eigen::Matrix<S, 3, 3>;
-  auto data = chain.make_data();
-  compute_kinematics(chain, data, q, qd);
-  M3 R = M3::Identity();
-  V3 p = V3::Zero(), v = V3::Zero(), w = V3::Zero();
-  T = S(0);
-  V = S(0);
-  chain.forward(data, [&](const auto& seg, const auto& kin, int, int off) {
-    using Seg = std::decay_t<decltype(seg)>;
-    constexpr int n = Seg::nq;
-    V3 v_rel = V3::Zero(), w_rel = V3::Zero();
-    if constexpr (n > 0) {
-      const auto qds = qd.template segment<n>(off);
-      v_rel = kin.J_distal.template topRows<3>() * qds;
-      w_rel = kin.J_distal.template bottomRows<3>() * qds;
-      if constexpr (detail::num_sub_bodies<Seg> > 0) {
-        for (const auto& b : kin.sub_bodies) {
-          const V3 vb = v + w.cross(R * b.r_base_body) + R * (b.J_v * qds);
-          const V3 wb = w + R * (b.J_w * qds);
-          const M3 Ib = R * b.inertia * R.transpose();
-          T += S(0.5) * b.mass * vb.squaredNorm() + S(0.5) * wb.dot(Ib * wb);
-          V -= b.mass * chain.gravity.dot(p + R * b.r_base_body);
-        }
-      } else if constexpr (Seg::has_body) {
-        const V3 vc = v + w.cross(R * kin.r_base_com) + R * (kin.J_com * qds);
-        const V3 wb = (R * kin.R_base_distal).transpose() * (w + R * w_rel);
-        T += S(0.5) * seg.mass * vc.squaredNorm() + S(0.5) * wb.dot(kin.inertia_com * wb);
-        V -= seg.mass * chain.gravity.dot(p + R * kin.r_base_com);
-      }
-    } else if constexpr (Seg::has_body) {
-      const V3 vc = v + w.cross(R * kin.r_base_com);
-      const V3 wb = (R * kin.R_base_distal).transpose() * w;
-      T += S(0.5) * seg.mass * vc.squaredNorm() + S(0.5) * wb.dot(kin.inertia_com * wb);
-      V -= seg.mass * chain.gravity.dot(p + R * kin.r_base_com);
-    }
-    v = v + w.cross(R * kin.r_base_distal) + R * v_rel;
-    p = p + R * kin.r_base_distal;
-    w = w + R * w_rel;
-    R = R * kin.R_base_distal;
-  });
-}
-
-#if SOFTRNE_TEST_AUTODIFF_REFERENCES
-// The energies above as one object, for the references of support.hpp.
-constexpr auto kEnergies = [](const auto& chain, const auto& q, const auto& qd, auto& T, auto& V) {
-  energies(chain, q, qd, T, V);
-};
-#endif
+// segments), differentiated with AutoDiff (autodiff_reference.hpp, as tests/core/test_rnea.cpp
+// does for the lumped chain).
 
 // Distributed CC joints mixed with links, a revolute joint and a lumped CC joint.
 DynamicChain<double> mixed() {
@@ -371,26 +277,7 @@ DynamicChain<double> dist_only() {
 }
 
 #if SOFTRNE_TEST_AUTODIFF_REFERENCES
-void check_against_lagrangian(const DynamicChain<double>& chain, int states, double q_scale,
-                              unsigned seed) {
-  const auto chain_ad = chain.cast<softrne_test::ADL>();
-  auto data = chain.make_data();
-  std::mt19937 rng(seed);
-  const int n = chain.num_coordinates();
-  double worst = 0;
-  for (int s = 0; s < states; ++s) {
-    const VectorXd q = softrne_test::random_vector(rng, n, q_scale);
-    const VectorXd qd = softrne_test::random_vector(rng, n, 2.0);
-    const VectorXd qdd = softrne_test::random_vector(rng, n, 5.0);
-    const VectorXd tau = rnea(chain, data, q, qd, qdd);
-    const VectorXd ref = softrne_test::euler_lagrange(kEnergies, chain_ad, q, qd, qdd);
-    const double e = (tau - ref).norm() / std::max(1e-3, ref.norm());
-    worst = std::max(worst, e);
-    ASSERT_LT(e, 1e-9) << "state " << s << "\nrnea " << tau.transpose() << "\nEL   " << ref.transpose();
-  }
-  std::printf("[ info ] %d coordinates: worst relative |rnea - Euler-Lagrange| = %.2e\n", n, worst);
-}
-
+using softrne_test::check_against_lagrangian;
 TEST(DistributedLagrangian, DistributedOnly) { check_against_lagrangian(dist_only(), 40, 1.6, 41); }
 TEST(DistributedLagrangian, MixedChain) { check_against_lagrangian(mixed(), 40, 1.6, 42); }
 #else
@@ -507,7 +394,7 @@ TEST(DistributedEnergy, FreeMotionConservesEnergy) {
   auto data = arm.make_data();
   auto energy = [&](const VQ& q, const VQ& qd) {
     double T, V;
-    energies(arm, q, qd, T, V);
+    softrne_test::energies(arm, q, qd, T, V);
     return T + V + 0.5 * q.dot(k.cwiseProduct(q));
   };
   auto accel = [&](const VQ& q, const VQ& qd) {
@@ -517,7 +404,7 @@ TEST(DistributedEnergy, FreeMotionConservesEnergy) {
   VQ q = (VQ() << 0.9, -0.6, 1.2, 0.4).finished(), qd = (VQ() << 0.0, 2.0, -3.0, 1.0).finished();
   const double E0 = energy(q, qd);
   double T0, V0;
-  energies(arm, q, qd, T0, V0);
+  softrne_test::energies(arm, q, qd, T0, V0);
   const double dt = 2e-4;
   double drift = 0, max_speed = 0;
   for (int step = 0; step < 15000; ++step) {  // 3 s, RK4
@@ -534,7 +421,7 @@ TEST(DistributedEnergy, FreeMotionConservesEnergy) {
   }
   // T from the disks equals 1/2 qd^T M qd.
   double T, V;
-  energies(arm, q, qd, T, V);
+  softrne_test::energies(arm, q, qd, T, V);
   EXPECT_LT(std::abs(T - 0.5 * qd.dot(mass_matrix(arm, data, q) * qd)), 1e-13 * std::max(1.0, T));
   std::printf("[ info ] 3 s free motion (max |qd| %.2f rad/s, T0 %.3f J): max |E - E0| = %.2e J\n",
               max_speed, T0, drift);

@@ -1,7 +1,7 @@
 // The generic RNE against the Euler-Lagrange equations of the lumped energy, differentiated
-// with AutoDiff (SOFTRNE_TEST_AUTODIFF_REFERENCES, support.hpp); cross-identities between
-// rnea, gravity, bias and mass_matrix; static chain
-// == runtime chain; closed-form statics; no heap allocation.
+// with AutoDiff (autodiff_reference.hpp, SOFTRNE_TEST_AUTODIFF_REFERENCES); cross-identities
+// between rnea, gravity, bias and mass_matrix; static chain == runtime chain; closed-form
+// statics; no heap allocation.
 #include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
 #include <gtest/gtest.h>
 
@@ -10,63 +10,15 @@
 #include <Eigen/Eigenvalues>
 
 #include "softrne/softrne.hpp"
+#include "autodiff_reference.hpp"
 #include "support.hpp"
 
 namespace {
 
 using namespace softrne;
-using softrne_test::AD;
 using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
-
-// ---------------------------------------------------------------------------------------
-#if SOFTRNE_TEST_AUTODIFF_REFERENCES
-// Euler-Lagrange reference. T and V are computed here from scratch: the segments give only
-// their own pose, Jacobians and inertia; velocities are propagated in the world frame by this
-// helper (no RNE code), and AutoDiff differentiates T and V.
-template <class ChainT, class QV>
-void energies(const ChainT& chain, const QV& q, const QV& qd, typename ChainT::Scalar& T,
-              typename ChainT::Scalar& V) {
-  using S = typename ChainT::Scalar;
-  using V3 = Eigen::Matrix<S, 3, 1>;
-  using M3 = Eigen::Matrix<S, 3, 3>;
-  auto data = chain.make_data();
-  compute_kinematics(chain, data, q, qd);
-  M3 R = M3::Identity();
-  V3 p = V3::Zero(), v = V3::Zero(), w = V3::Zero();
-  T = S(0);
-  V = S(0);
-
-  chain.forward(data, [&](const auto& seg, const auto& kin, int, int off) {
-    constexpr int n = std::decay_t<decltype(seg)>::nq;
-    V3 v_rel = V3::Zero(), w_rel = V3::Zero(), vc_rel = V3::Zero();
-    if constexpr (n > 0) {
-      const auto qds = qd.template segment<n>(off);
-      v_rel = kin.J_distal.template topRows<3>() * qds;
-      w_rel = kin.J_distal.template bottomRows<3>() * qds;
-      vc_rel = kin.J_com * qds;
-    }
-    const V3 w_body = w + R * w_rel;  // world angular velocity of the distal frame
-    if constexpr (std::decay_t<decltype(seg)>::has_body) {
-      const V3 vc = v + w.cross(R * kin.r_base_com) + R * vc_rel;
-      const M3 Rd = R * kin.R_base_distal;
-      const V3 wb = Rd.transpose() * w_body;
-      T += S(0.5) * seg.mass * vc.squaredNorm() + S(0.5) * wb.dot(kin.inertia_com * wb);
-      V -= seg.mass * chain.gravity.dot(p + R * kin.r_base_com);
-    }
-    v = v + w.cross(R * kin.r_base_distal) + R * v_rel;
-    p = p + R * kin.r_base_distal;
-    R = R * kin.R_base_distal;
-    w = w_body;
-  });
-}
-
-// The energies above as one object, for the references of support.hpp.
-constexpr auto kEnergies = [](const auto& chain, const auto& q, const auto& qd, auto& T, auto& V) {
-  energies(chain, q, qd, T, V);
-};
-#endif
 
 DynamicChain<double> cc_only() {
   DynamicChain<double> c;
@@ -102,26 +54,7 @@ DynamicChain<double> long_chain(int n_cc) {
   return c;
 }
 
-void check_against_lagrangian(const DynamicChain<double>& chain, int states, double q_scale,
-                              unsigned seed) {
-  const auto chain_ad = chain.cast<softrne_test::ADL>();
-  auto data = chain.make_data();
-  std::mt19937 rng(seed);
-  const int n = chain.num_coordinates();
-  double worst = 0;
-  for (int s = 0; s < states; ++s) {
-    const VectorXd q = softrne_test::random_vector(rng, n, q_scale);
-    const VectorXd qd = softrne_test::random_vector(rng, n, 2.0);
-    const VectorXd qdd = softrne_test::random_vector(rng, n, 5.0);
-    const VectorXd tau = rnea(chain, data, q, qd, qdd);
-    const VectorXd ref = softrne_test::euler_lagrange(kEnergies, chain_ad, q, qd, qdd);
-    const double e = (tau - ref).norm() / std::max(1e-3, ref.norm());
-    worst = std::max(worst, e);
-    ASSERT_LT(e, 1e-9) << "state " << s << "\nrnea " << tau.transpose() << "\nEL   " << ref.transpose();
-  }
-  std::printf("[ info ] %d coordinates: worst relative |rnea - Euler-Lagrange| = %.2e\n", n, worst);
-}
-
+using softrne_test::check_against_lagrangian;
 TEST(RneaLagrangian, CcOnlyChain) { check_against_lagrangian(cc_only(), 100, 1.6, 11); }
 TEST(RneaLagrangian, PaperArm) { check_against_lagrangian(softrne_test::paper_arm(), 100, 1.6, 12); }
 TEST(RneaLagrangian, HybridWithRevoluteJoints) { check_against_lagrangian(hybrid(), 100, 1.6, 13); }
@@ -138,10 +71,10 @@ TEST(RneaLagrangian, PaperFrozenInertiaIsNotLagrangian) {
   const VectorXd q = softrne_test::random_vector(rng, 6, 1.0);
   const VectorXd qd = softrne_test::random_vector(rng, 6, 2.0);
   const VectorXd qdd = softrne_test::random_vector(rng, 6, 5.0);
-  const VectorXd ref = softrne_test::euler_lagrange(kEnergies, chain_ad, q, qd, qdd);
+  const VectorXd ref = softrne_test::euler_lagrange(chain_ad, q, qd, qdd);
   EXPECT_GT((rnea(chain, data, q, qd, qdd) - ref).norm() / ref.norm(), 1e-6);
   const VectorXd z = VectorXd::Zero(6);
-  const VectorXd ref_at_rest = softrne_test::euler_lagrange(kEnergies, chain_ad, q, z, qdd);
+  const VectorXd ref_at_rest = softrne_test::euler_lagrange(chain_ad, q, z, qdd);
   EXPECT_LT((rnea(chain, data, q, z, qdd) - ref_at_rest).norm(), 1e-9);
 }
 #else
@@ -178,7 +111,7 @@ TEST(RneaIdentities, GravityBiasMassMatrix) {
 #if SOFTRNE_TEST_AUTODIFF_REFERENCES
       // G = dV/dq.
       VectorXd a, b, dV;
-      softrne_test::lagrangian_gradients(kEnergies, chain_ad, q, qd, a, b, dV);
+      softrne_test::lagrangian_gradients(chain_ad, q, qd, a, b, dV);
       EXPECT_LT(softrne_test::rel_err(G, dV), 1e-12);
 #endif
       // qd^T (dM/dt - 2C) qd = 0 with dM/dt by a central difference along qd.
