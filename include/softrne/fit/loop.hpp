@@ -57,7 +57,8 @@ namespace softrne::fit {
 /// effect-free random arms (tools/score-loop.py, docs/closing-the-loop.md) that got any effect.
 inline constexpr const char* kCalibratedFalsePositiveRate =
     "1 of 23 effect-free random arms (4 %) got an effect (tools/score-loop.py, the controls "
-    "among seeds 1000-1039 and --controls-only 5000-5012, 2026-12-01/02; docs/closing-the-loop.md)";
+    "among seeds 1000-1039 and --controls-only 5000-5012, all 23 with the loop of 2026-12-03; "
+    "docs/closing-the-loop.md)";
 
 /// \brief Settings of the closed loop.
 struct LoopOptions {
