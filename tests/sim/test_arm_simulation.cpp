@@ -20,6 +20,7 @@
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_spec.hpp"
 #include "softrne/model/arm_model.hpp"
+#include "softrne/signals/pchip.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 
 #if __has_include(<nlohmann/json.hpp>)
@@ -294,7 +295,7 @@ TEST(ArmSimulation, TwoJointArmOscillatesWithTheModesOfItsLinearisation) {
 MatrixXd rk4_reference(const ArmDescription& d, const VectorXd& t, const MatrixXd& P,
                        const VectorXd& x0, int substeps) {
   softrne::ArmDynamics<double> f(d);
-  softrne::sim::PchipSignal u(t, P);
+  softrne::signals::PchipSignal u(t, P);
   VectorXd p(d.num_inputs);
   const int ns = d.num_states();
   auto rhs = [&](double tt, const VectorXd& x, VectorXd& xd) {

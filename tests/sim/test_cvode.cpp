@@ -17,7 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "oscillator.hpp"
-#include "softrne/sim/input_signal.hpp"
+#include "softrne/signals/input_signal.hpp"
 
 namespace {
 
@@ -35,7 +35,7 @@ using softrne_test::StepForce;
 // from the right at every t (as a naive system would).
 struct ForcedOscillator {
   Oscillator osc;
-  softrne::sim::InputSignal force;
+  softrne::signals::InputSignal force;
   double segment_end = std::numeric_limits<double>::infinity();
   long calls = 0;
   bool forbid_malloc = false;  // forbid Eigen heap allocation from the first rhs call on
@@ -46,7 +46,8 @@ struct ForcedOscillator {
     ++calls;
     Eigen::Matrix<double, 1, 1> F;
     // At the end of a segment, the value held before the jump (see cvode.hpp).
-    force.value(t, F, t >= segment_end ? softrne::sim::Side::left : softrne::sim::Side::right);
+    using softrne::signals::Side;
+    force.value(t, F, t >= segment_end ? Side::left : Side::right);
     xdot[0] = x[1];
     xdot[1] = F[0] - 2.0 * osc.zeta * osc.w * x[1] - osc.w * osc.w * x[0];
   }
@@ -91,7 +92,7 @@ void setup_oscillator(System& sys) {
   t << 0.0, 0.5, 1.2345, 2.0, 3.0;
   VectorXd F(5);
   F << 0.0, 20.0, -10.0, 35.0, 0.0;
-  sys.force = softrne::sim::InputSignal(t, F, softrne::sim::Interpolation::zero_order_hold);
+  sys.force = softrne::signals::InputSignal(t, F, softrne::signals::Interpolation::zero_order_hold);
 }
 
 VectorXd oscillator_output_times() {

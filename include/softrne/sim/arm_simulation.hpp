@@ -27,11 +27,19 @@
 #include "softrne/config.hpp"
 #include "softrne/algorithms/rnea.hpp"
 #include "softrne/model/arm_model.hpp"
+#include "softrne/signals/input_signal.hpp"
+#include "softrne/signals/pchip.hpp"
 #include "softrne/sim/cvode.hpp"
-#include "softrne/sim/input_signal.hpp"
-#include "softrne/sim/pchip_signal.hpp"
 
 namespace softrne::sim {
+
+// The signals the simulator reads its pressures through, under the names they had when they
+// lived in sim/ (before signals/): user code that included only this header names them so.
+using signals::InputSignal;
+using signals::Interpolation;
+using signals::PchipSignal;
+using signals::Side;
+using signals::SignalCursor;
 
 /// \brief Settings of simulate_arm.
 struct ArmSimulationOptions {

@@ -25,7 +25,7 @@
 /// segment evaluates f at \f$t_{end}\f$ itself: a zero-order-hold input must
 /// give there the value held *before* the jump, or the error test sees the
 /// jump and shrinks the step to ~tolerance/jump. Use set_segment and e.g.
-/// `u.value(t, out, t >= t_end ? Side::left : Side::right)` (InputSignal).
+/// `u.value(t, out, t >= t_end ? Side::left : Side::right)` (signals::InputSignal).
 ///
 /// Callbacks receive Eigen::Map views of CVODE's own vectors: declare their
 /// parameters as `Eigen::Ref` (or templates), not `const Eigen::VectorXd&`,

@@ -5,14 +5,14 @@
 
 #include <gtest/gtest.h>
 
-#include "softrne/sim/input_signal.hpp"
+#include "softrne/signals/input_signal.hpp"
 
 namespace {
 
-using softrne::sim::InputSignal;
-using softrne::sim::Interpolation;
-using softrne::sim::Side;
-using softrne::sim::SignalCursor;
+using softrne::signals::InputSignal;
+using softrne::signals::Interpolation;
+using softrne::signals::Side;
+using softrne::signals::SignalCursor;
 
 // Irregular times, two channels: channel 0 = 10 * i, channel 1 = a ramp with a repeat.
 InputSignal make_signal(Interpolation interp) {
