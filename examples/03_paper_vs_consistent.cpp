@@ -4,7 +4,7 @@
 #include <random>
 
 #include <softrne/fit/arm_fit.hpp>
-#include <softrne/fit/savitzky_golay.hpp>
+#include <softrne/signals/savitzky_golay.hpp>
 #include <softrne/io/robot_json.hpp>
 int main(int argc, char** argv) {
   if (argc < 3) {
@@ -19,9 +19,9 @@ int main(int argc, char** argv) {
   auto ca = a.make_chain<double>(), cb = b.make_chain<double>();
   auto da = ca.make_data(), db = cb.make_data();
   // along the measured trajectory (SG derivatives)
-  softrne::fit::SgOptions sg;
+  softrne::signals::SgOptions sg;
   Eigen::MatrixXd q, qd, qdd;
-  softrne::fit::savgol(data.t, data.angles, sg, q, qd, qdd);
+  softrne::signals::savgol(data.t, data.angles, sg, q, qd, qdd);
   double maxd = 0, maxt = 0;
   for (int i = 0; i < q.rows(); ++i) {
     Eigen::VectorXd x = q.row(i).transpose(), v = qd.row(i).transpose(), w = qdd.row(i).transpose();

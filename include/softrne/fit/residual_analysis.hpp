@@ -15,7 +15,7 @@
 
 #include "softrne/config.hpp"
 #include "softrne/fit/noise_floor.hpp"
-#include "softrne/fit/savitzky_golay.hpp"
+#include "softrne/signals/savitzky_golay.hpp"
 #include "softrne/model/arm_model.hpp"
 
 namespace softrne::fit {
@@ -114,13 +114,13 @@ SOFTRNE_FIT_INLINE UnexplainedResidual analyse_residual(const ArmDescription& de
   const Eigen::MatrixXd e = measured.topRows(n) - simulated.topRows(n);
   const Eigen::VectorXd tt = t.head(n);
   Eigen::MatrixXd q, qd, qdd, drive(n, desc.nq), drive_s, drive_d, drive_dd;
-  savgol(tt, measured.topRows(n), SgOptions{}, q, qd, qdd);
+  signals::savgol(tt, measured.topRows(n), signals::SgOptions{}, q, qd, qdd);
   drive.setZero();
   for (const auto& j : desc.joints)
     for (int k = 0; k < j.nq; ++k)
       for (int c = 0; c < j.num_inputs; ++c)
         drive.col(j.q_offset + k) += j.pressure_to_torque(k, c) * pressures.col(j.input_offset + c).head(n);
-  savgol(tt, drive, SgOptions{}, drive_s, drive_d, drive_dd);
+  signals::savgol(tt, drive, signals::SgOptions{}, drive_s, drive_d, drive_dd);
   std::string above;
   for (int k = 0; k < desc.nq; ++k) {
     CoordinateResidual c;

@@ -7,13 +7,13 @@
 
 #include <gtest/gtest.h>
 
-#include <softrne/fit/savitzky_golay.hpp>
+#include <softrne/signals/savitzky_golay.hpp>
 
 namespace {
 
-using softrne::fit::savgol;
-using softrne::fit::savgol_weights;
-using softrne::fit::SgOptions;
+using softrne::signals::savgol;
+using softrne::signals::savgol_weights;
+using softrne::signals::SgOptions;
 
 // Platform-independent N(0,1) from raw mt19937_64 bits (Box-Muller).
 struct Gauss {
