@@ -473,24 +473,6 @@ TEST(ArmSimulation, VelocityToleranceScalingOnlyChangesTheTolerances) {
   EXPECT_LT((sa.states - sc.states).cwiseAbs().maxCoeff(), 1e-8);
 }
 
-TEST(ArmSimulation, PressureSmoothingIsOptionalZeroPhaseAndMonotone) {
-  const VectorXd t = VectorXd::LinSpaced(201, 0.0, 2.0);
-  MatrixXd P(t.size(), 2);
-  for (Eigen::Index i = 0; i < t.size(); ++i) {
-    P(i, 0) = 5e4;                          // constant
-    P(i, 1) = t(i) < 1.0 - 1e-9 ? 0 : 1e5;  // a step at t = 1
-  }
-  EXPECT_EQ(softrne::sim::smooth_pressures(t, P, 0.0), P);  // off
-  const MatrixXd S = softrne::sim::smooth_pressures(t, P, 0.02);
-  EXPECT_LT((S.col(0).array() - 5e4).abs().maxCoeff(), 1e-9);
-  for (Eigen::Index i = 1; i < t.size(); ++i) EXPECT_GE(S(i, 1), S(i - 1, 1) - 1e-9);  // monotone
-  EXPECT_GE(S.col(1).minCoeff(), 0.0);
-  EXPECT_LE(S.col(1).maxCoeff(), 1e5 * (1 + 1e-14));
-  // Zero phase: symmetric about the step (between samples 99 and 100).
-  for (int k = 0; k < 10; ++k) EXPECT_NEAR(S(99 - k, 1) + S(100 + k, 1), 1e5, 1e-6);
-  EXPECT_EQ(S(0, 1), 0.0);
-}
-
 TEST(ArmSimulation, ReportsProgressAndFailsWithOneLine) {
   const ArmDescription d = build_arm(two_joint_arm(Eigen::Vector3d(0, 0, 9.81)));
   const VectorXd t = VectorXd::LinSpaced(301, 0.0, 3.0);

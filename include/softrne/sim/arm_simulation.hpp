@@ -28,7 +28,9 @@
 #include "softrne/algorithms/rnea.hpp"
 #include "softrne/model/arm_model.hpp"
 #include "softrne/signals/input_signal.hpp"
+#include "softrne/signals/jumps.hpp"
 #include "softrne/signals/pchip.hpp"
+#include "softrne/signals/smoothing.hpp"
 #include "softrne/sim/cvode.hpp"
 
 namespace softrne::sim {
@@ -38,8 +40,10 @@ namespace softrne::sim {
 using signals::InputSignal;
 using signals::Interpolation;
 using signals::PchipSignal;
+using signals::pressure_jumps;
 using signals::Side;
 using signals::SignalCursor;
+using signals::smooth_pressures;
 
 /// \brief Settings of simulate_arm.
 struct ArmSimulationOptions {
@@ -90,68 +94,6 @@ struct ArmSimulation {
   /// \return True if the integration reached the end of the grid.
   bool ok() const { return result.ok; }
 };
-
-/// \brief Times where the recorded pressures jump (a pressure step): the integrator restarts
-/// there. A jump is a sample-to-sample change larger than both 10x the channel's median change
-/// (noise) and 5% of its range; relative, so it does not depend on units or the robot.
-/// \param[in] t The N sample times, s.
-/// \param[in] p N x P recorded pressures.
-/// \return The sample times where a step starts, increasing.
-inline std::vector<double> pressure_jumps(const Eigen::VectorXd& t, const Eigen::MatrixXd& p) {
-  std::vector<double> out;
-  const Eigen::Index n = t.size();
-  if (n < 3 || p.cols() == 0) return out;
-  const Eigen::MatrixXd d = (p.bottomRows(n - 1) - p.topRows(n - 1)).cwiseAbs();
-  Eigen::VectorXd thr(p.cols());
-  for (Eigen::Index c = 0; c < p.cols(); ++c) {
-    std::vector<double> col(d.col(c).data(), d.col(c).data() + d.rows());
-    std::nth_element(col.begin(), col.begin() + static_cast<long>(col.size() / 2), col.end());
-    const double med = col[col.size() / 2];
-    const double range = p.col(c).maxCoeff() - p.col(c).minCoeff();
-    thr(c) = std::max(10 * med, 0.05 * range);
-    if (!(thr(c) > 0)) thr(c) = std::numeric_limits<double>::infinity();
-  }
-  for (Eigen::Index i = 0; i + 1 < n; ++i)
-    for (Eigen::Index c = 0; c < p.cols(); ++c)
-      if (d(i, c) > thr(c)) {
-        out.push_back(t(i));  // the ramp of a step starts at sample i
-        break;
-      }
-  return out;
-}
-
-/// \brief Zero-phase Gaussian smoothing of sampled signals (one column per channel), for
-/// ArmSimulationOptions::pressure_smoothing: row i becomes the weighted mean of the rows j with
-/// weights exp(-(t_j - t_i)^2 / (2 sigma^2)) - exp(-8), cut off at |t_j - t_i| = 4 sigma where
-/// they reach zero (so that rounding in the window bounds cannot matter), renormalised at the
-/// ends. Works on irregular grids; non-negative weights, so no overshoot at pressure steps.
-/// sigma <= 0 returns the input. Cost O(N * window).
-/// \param[in] t The N sample times, s (irregular allowed).
-/// \param[in] p N x P samples.
-/// \param[in] sigma The kernel's standard deviation, s.
-/// \return The smoothed N x P samples.
-inline Eigen::MatrixXd smooth_pressures(const Eigen::VectorXd& t, const Eigen::MatrixXd& p,
-                                        double sigma) {
-  if (!(sigma > 0) || t.size() < 2) return p;
-  const Eigen::Index n = t.size();
-  Eigen::MatrixXd out(p.rows(), p.cols());
-  const double reach = 4 * sigma, inv2s2 = 1.0 / (2 * sigma * sigma), floor = std::exp(-8.0);
-  Eigen::Index lo = 0, hi = 0;  // window [lo, hi) around sample i
-  for (Eigen::Index i = 0; i < n; ++i) {
-    while (t(lo) < t(i) - reach) ++lo;
-    while (hi < n && t(hi) <= t(i) + reach) ++hi;
-    double wsum = 0;
-    out.row(i).setZero();
-    for (Eigen::Index j = lo; j < hi; ++j) {
-      const double dt = t(j) - t(i);
-      const double w = std::max(0.0, std::exp(-dt * dt * inv2s2) - floor);
-      out.row(i) += w * p.row(j);
-      wsum += w;
-    }
-    out.row(i) /= wsum;  // >= the weight of j = i, 1 - exp(-8)
-  }
-  return out;
-}
 
 /// \brief The arm as an ODE system for CVODE: x' = f(t, x) with the interpolated recorded
 /// pressures, and its exact Jacobian by AutoDiff (blocks of kBlock directions at a time).
