@@ -50,6 +50,7 @@
 #include "softrne/fit/candidates.hpp"
 #include "softrne/fit/noise_floor.hpp"
 #include "softrne/fit/residual_analysis.hpp"
+#include "softrne/signals/noise_sigma.hpp"
 
 namespace softrne::fit {
 
@@ -342,7 +343,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   const sim::ArmSimulationOptions& sim_opt = opt.fit.simulation;
   const Eigen::Index N = train.t.size();
 
-  out.noise_sigma = estimate_noise_sigma(train.angles);
+  out.noise_sigma = signals::estimate_noise_sigma(train.angles);
   out.noise_floor = noise_floor_median(std::sqrt(out.noise_sigma.squaredNorm() /
                                                  std::max<Eigen::Index>(1, out.noise_sigma.size())));
 
