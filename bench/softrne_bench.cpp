@@ -45,9 +45,9 @@
 #endif
 
 #ifdef SOFTRNE_BENCH_WITH_SIM
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 #endif
 

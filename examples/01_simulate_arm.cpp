@@ -14,9 +14,9 @@
 
 #include <Eigen/Core>
 
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/model/error_stats.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 

@@ -26,7 +26,7 @@
   } while (false)
 #endif
 
-/// \brief Header-only or compiled: the heavy entry points of the arm layer (model/, sim/:
+/// \brief Header-only or compiled: the heavy entry points of the arm layer (arm/, sim/:
 /// SOFTRNE_SIM_*) and of fit/ (SOFTRNE_FIT_*).
 ///
 /// softrne is header-only: by default these functions are `inline` and compiled in every

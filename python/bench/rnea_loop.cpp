@@ -10,8 +10,8 @@
 #include <random>
 #include <vector>
 
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/softrne.hpp"
 
 int main(int argc, char** argv) {

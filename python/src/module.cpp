@@ -32,12 +32,12 @@
 #include <numpy/arrayobject.h>
 
 #include "common/report.hpp"
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/fit/arm_fit.hpp"
 #include "softrne/fit/loop.hpp"
 #include "softrne/fit/parallel_for.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 #include "softrne/softrne.hpp"
 

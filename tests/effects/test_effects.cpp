@@ -19,8 +19,8 @@
 
 #include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/algorithms/rnea.hpp"
+#include "softrne/arm/arm_dynamics.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 #include "softrne/sim/fixed_step.hpp"
 

@@ -5,9 +5,9 @@
 #include <random>
 #include <string>
 
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/fit/arm_fit.hpp"
 #include "softrne/io/robot_spec.hpp"
-#include "softrne/model/arm_model.hpp"
 
 namespace softrne_test {
 

@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 #include <unsupported/Eigen/AutoDiff>
 
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/arm_model.hpp"
 
 namespace sio = softrne::io;
 using nlohmann::json;

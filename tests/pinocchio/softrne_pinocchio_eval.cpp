@@ -18,8 +18,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/softrne.hpp"
 
 namespace {

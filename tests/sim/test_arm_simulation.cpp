@@ -17,9 +17,9 @@
 #include <gtest/gtest.h>
 
 #include "softrne/algorithms/mass_matrix.hpp"
+#include "softrne/arm/arm_dynamics.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_spec.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/signals/pchip.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 

@@ -71,9 +71,9 @@
 
 #include "softrne/algorithms/bias.hpp"
 #include "softrne/algorithms/mass_matrix.hpp"
+#include "softrne/arm/arm_dynamics.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_spec.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 
 namespace softrne::gen {

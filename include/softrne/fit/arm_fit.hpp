@@ -14,10 +14,10 @@
 #include <Eigen/Core>
 
 #include "softrne/config.hpp"
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/fit/least_squares.hpp"
 #include "softrne/fit/parameters.hpp"
 #include "softrne/io/csv.hpp"
-#include "softrne/model/arm_model.hpp"
 #include "softrne/model/error_stats.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 

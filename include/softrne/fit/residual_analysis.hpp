@@ -14,9 +14,9 @@
 #include <Eigen/Core>
 
 #include "softrne/config.hpp"
+#include "softrne/arm/arm_description.hpp"
 #include "softrne/fit/noise_floor.hpp"
 #include "softrne/signals/savitzky_golay.hpp"
-#include "softrne/model/arm_model.hpp"
 
 namespace softrne::fit {
 

@@ -26,7 +26,7 @@
 
 #include "softrne/config.hpp"
 #include "softrne/algorithms/rnea.hpp"
-#include "softrne/model/arm_model.hpp"
+#include "softrne/arm/arm_dynamics.hpp"
 #include "softrne/signals/input_signal.hpp"
 #include "softrne/signals/jumps.hpp"
 #include "softrne/signals/pchip.hpp"
