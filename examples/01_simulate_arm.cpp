@@ -17,7 +17,7 @@
 #include "softrne/arm/arm_description.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/error_stats.hpp"
+#include "softrne/signals/error_stats.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 
 int main(int argc, char** argv) {
@@ -58,9 +58,10 @@ int main(int argc, char** argv) {
         duration, data_path.c_str(), 1e3 * s.wall_seconds, duration / s.wall_seconds, s.steps,
         s.rhs_evals, s.jac_evals, out_path.c_str());
     if (data.has_angles) {
-      const softrne::ErrorStats err =
-          softrne::error_stats(sim.angles, data.angles, arm.coordinate_names);
-      std::printf("%s", softrne::format_error_table(err, "simulation vs measurement:").c_str());
+      const softrne::signals::ErrorStats err =
+          softrne::signals::error_stats(sim.angles, data.angles, arm.coordinate_names);
+      std::printf("%s",
+                  softrne::signals::format_error_table(err, "simulation vs measurement:").c_str());
     }
     return 0;
   } catch (const std::exception& e) {  // io::InputError: "<file>: <where>: <what>"

@@ -17,7 +17,7 @@
 #include "softrne/arm/arm_description.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/error_stats.hpp"
+#include "softrne/signals/error_stats.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 
 namespace {
@@ -190,9 +190,9 @@ int run_sim(int argc, char** argv) {
   }
 
   if (data.has_angles) {
-    const softrne::ErrorStats stats =
-        softrne::error_stats(sim.angles, data.angles, desc.coordinate_names);
-    report << softrne::format_error_table(
+    const softrne::signals::ErrorStats stats =
+        softrne::signals::error_stats(sim.angles, data.angles, desc.coordinate_names);
+    report << softrne::signals::format_error_table(
         stats, "absolute error, simulation vs measured angles of " + data_path + ":");
   }
   if (opt.pressure_smoothing > 0)

@@ -13,12 +13,12 @@
 #include "softrne/fit/arm_fit.hpp"
 #include "softrne/fit/loop.hpp"
 #include "softrne/io/robot_json.hpp"
-#include "softrne/model/error_stats.hpp"
+#include "softrne/signals/error_stats.hpp"
 
 namespace softrne::cli {
 
 /// \brief `STATS` of formats.md section 5.
-inline nlohmann::ordered_json stats_json(const ErrorStats& s) {
+inline nlohmann::ordered_json stats_json(const signals::ErrorStats& s) {
   nlohmann::ordered_json j;
   j["mean"] = s.total.mean;
   j["median"] = s.total.median;
@@ -83,19 +83,20 @@ inline nlohmann::ordered_json unexplained_json(const fit::UnexplainedResidual& u
 /// and where a held-out data set is given the errors of both models on it.
 struct FitRun {
   fit::ArmFitResult result;
-  ErrorStats train_before;
+  signals::ErrorStats train_before;
   bool has_test = false;
-  ErrorStats test_before, test_after;
+  signals::ErrorStats test_before, test_after;
 };
 
 /// \brief Error statistics of model `d` simulated on `data`; cli::Failure naming the data set
 /// if it does not simulate (`which`: "starting", "fitted").
-inline ErrorStats simulated_errors(const ArmDescription& d, const io::Dataset& data,
-                                   const sim::ArmSimulationOptions& opt, const std::string& which) {
+inline signals::ErrorStats simulated_errors(const ArmDescription& d, const io::Dataset& data,
+                                            const sim::ArmSimulationOptions& opt,
+                                            const std::string& which) {
   const auto s = fit::simulate_dataset(d, data, opt);
   if (!s.ok())
     throw Failure(data.source + ": the " + which + " model fails to simulate: " + s.result.message);
-  return error_stats(s.angles, data.angles, d.coordinate_names);
+  return signals::error_stats(s.angles, data.angles, d.coordinate_names);
 }
 
 /// \brief Fits `desc` to `train` (fit::fit_arm) and measures it before and after, on `train`

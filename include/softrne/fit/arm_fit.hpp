@@ -18,8 +18,17 @@
 #include "softrne/fit/least_squares.hpp"
 #include "softrne/fit/parameters.hpp"
 #include "softrne/io/csv.hpp"
-#include "softrne/model/error_stats.hpp"
+#include "softrne/signals/error_stats.hpp"
 #include "softrne/sim/arm_simulation.hpp"
+
+namespace softrne {
+// The error statistics under the names they had in model/ (softrne::ErrorStats, ...), before
+// they moved to signals/: user code that included only the fit headers names them so.
+using signals::error_stats;
+using signals::ErrorStats;
+using signals::ErrorSummary;
+using signals::format_error_table;
+}  // namespace softrne
 
 namespace softrne::fit {
 
@@ -76,7 +85,7 @@ struct ArmFitResult {
   ArmDescription fitted;    ///< the model with the fitted values
   FitResult fit;            ///< the optimiser's result (normalised and physical values)
   ParameterSet parameters;  ///< what was fitted, with bounds
-  ErrorStats stats;  ///< on the fitting data (all samples)
+  signals::ErrorStats stats;  ///< on the fitting data (all samples)
 
   /// The fitted model simulated through every sample of the data (N x nq), masked or not;
   /// empty if that simulation failed. Callers measure held-out errors on it.
@@ -262,7 +271,7 @@ SOFTRNE_FIT_INLINE ArmFitResult fit_arm(const ArmDescription& start, const io::D
   ++sims;
   if (s.ok() && s.angles.rows() == N && s.angles.allFinite()) {
     out.angles = s.angles;
-    out.stats = error_stats(s.angles, data.angles, out.fitted.coordinate_names);
+    out.stats = signals::error_stats(s.angles, data.angles, out.fitted.coordinate_names);
   }
   out.simulations = sims;
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -131,7 +131,7 @@ struct InertiaChoice {
 /// \brief Outcome of run_loop.
 struct LoopResult {
   ArmFitResult baseline;  ///< the declared model fitted (stiffness, damping)
-  ErrorStats baseline_test, final_train, final_test;
+  signals::ErrorStats baseline_test, final_train, final_test;
   /// \var baseline_test
   /// \brief The baseline's errors on the test set (empty without one).
   /// \var final_train
@@ -352,7 +352,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   out.simulations += out.baseline.simulations;
   if (test) {
     const sim::ArmSimulation s = simulate_dataset(out.baseline.fitted, *test, sim_opt);
-    if (s.ok()) out.baseline_test = error_stats(s.angles, test->angles, out.baseline.fitted.coordinate_names);
+    if (s.ok()) out.baseline_test = signals::error_stats(s.angles, test->angles, out.baseline.fitted.coordinate_names);
   }
 
   // Fold base models, each fitted from the declared model on its own training blocks.
@@ -824,7 +824,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   const sim::ArmSimulation final_test_sim =
       test ? simulate_dataset(current, *test, sim_opt) : sim::ArmSimulation();
   if (test && final_test_sim.ok())
-    out.final_test = error_stats(final_test_sim.angles, test->angles, current.coordinate_names);
+    out.final_test = signals::error_stats(final_test_sim.angles, test->angles, current.coordinate_names);
   if (out.final_residual.size())
     out.unexplained_train = analyse_residual(current, train.t, train.angles, train.angles - out.final_residual,
                                              train.pressures, out.noise_sigma, opt.unexplained_ratio);
