@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <unsupported/Eigen/AutoDiff>
 
+#include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/arm/arm_description.hpp"
 #include "softrne/io/robot_json.hpp"
 

@@ -92,7 +92,8 @@ void setup_oscillator(System& sys) {
   t << 0.0, 0.5, 1.2345, 2.0, 3.0;
   VectorXd F(5);
   F << 0.0, 20.0, -10.0, 35.0, 0.0;
-  sys.force = softrne::signals::InputSignal(t, F, softrne::signals::Interpolation::zero_order_hold);
+  using softrne::signals::Interpolation;
+  sys.force = softrne::signals::InputSignal(t, F, Interpolation::zero_order_hold);
 }
 
 VectorXd oscillator_output_times() {
