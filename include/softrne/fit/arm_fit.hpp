@@ -18,17 +18,10 @@
 #include "softrne/fit/least_squares.hpp"
 #include "softrne/fit/parameters.hpp"
 #include "softrne/io/csv.hpp"
-#include "softrne/signals/error_stats.hpp"
+// The error statistics (signals/error_stats.hpp) through the header that also keeps their old
+// names (softrne::ErrorStats, ...): user code that included only the fit headers names them so.
+#include "softrne/model/error_stats.hpp"
 #include "softrne/sim/arm_simulation.hpp"
-
-namespace softrne {
-// The error statistics under the names they had in model/ (softrne::ErrorStats, ...), before
-// they moved to signals/: user code that included only the fit headers names them so.
-using signals::error_stats;
-using signals::ErrorStats;
-using signals::ErrorSummary;
-using signals::format_error_table;
-}  // namespace softrne
 
 namespace softrne::fit {
 
