@@ -678,8 +678,8 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     // Gauss-Newton step, which moves every stiffness and damping as well as the effect, so it
     // can reach K, D values that the base model's own local refit (same budget) did not; its
     // held-out gain is then partly the optimiser's, not the effect's. On effect-free random
-    // arm 5003 a shared sensor gain of 1.011 gained 10 % / 34 % that way (the base's damping of
-    // the last joint 40 % too high, the refit's closer). So before a candidate wins, each
+    // arm 5003 a shared sensor gain of 1.011 gained 10 % / 34 % that way (the folds' models
+    // refitted from its refit without it: 12 % / 39 % better). So before a candidate wins, each
     // fold's model is refitted once more from that candidate's refit with its effect taken out
     // (its K, D and earlier effects); where that lowers the fold's held-out error it becomes the
     // fold's model, every refitted candidate's gains are measured again against it
