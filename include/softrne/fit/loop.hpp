@@ -294,6 +294,23 @@ inline std::vector<double> measured_gains(const std::vector<FoldTrial>& trials, 
   return gains;
 }
 
+/// The mean and the worst (smallest) of a candidate's per-fold held-out gains: it passes when
+/// the worst reaches min_gain, and the mean ranks it.
+struct GainSummary {
+  double mean = 0;
+  double worst = std::numeric_limits<double>::infinity();
+};
+inline GainSummary summarise(const std::vector<double>& gains) {
+  GainSummary g;
+  double sum = 0;
+  for (double x : gains) {
+    sum += x;
+    g.worst = std::min(g.worst, x);
+  }
+  g.mean = sum / static_cast<double>(gains.size());
+  return g;
+}
+
 /// The winner among the passing candidates (indices into `cv_gains` and `n_params`), or -1:
 /// the largest mean held-out gain, unless a candidate with fewer parameters leaves a held-out
 /// error within `margin` (relative) of the winner's, the same margin every effect must earn.
@@ -484,24 +501,21 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       const Candidate& cand = cands[score_cand[r]];
       std::vector<detail::FoldTrial> trials;
       std::vector<double> gains;
-      double sum = 0, mn = std::numeric_limits<double>::infinity();
       for (std::size_t f = 0; f < folds.size(); ++f) {
         AnyEffect e = cand.effect;
         effect_base(e).params = starts.empty() ? screens[f][score_cand[r]].start : starts[f];
         const ArmDescription& base = bases.empty() ? folds[f].model : bases[f];
         trials.push_back(detail::try_on_fold(folds[f], detail::with_effect(base, e), train, refit, &out.simulations));
         gains.push_back(trials.back().gain);
-        sum += gains.back();
-        mn = std::min(mn, gains.back());
       }
-      const double mean = sum / static_cast<double>(gains.size());
+      const detail::GainSummary summary = detail::summarise(gains);
       std::string line = "  " + s.label + ": held-out error";
       for (double g : gains) line += " " + detail::percent(g);
       std::string unconverged;
       for (std::size_t f = 0; f < trials.size(); ++f)
         if (!trials[f].fit.fit.converged) unconverged += (unconverged.empty() ? "" : ", ") + std::to_string(f + 1);
       if (!unconverged.empty()) line += " (refit budget spent in fold " + unconverged + ")";
-      if (s.confirmed && !(mean > s.cv_gain)) {
+      if (s.confirmed && !(summary.mean > s.cv_gain)) {
         log(line + " (the earlier refit is kept)");
         return;
       }
@@ -509,9 +523,9 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       s.confirmed = true;
       fold_trials[r] = std::move(trials);
       s.fold_gains = gains;
-      s.cv_gain = mean;
+      s.cv_gain = summary.mean;
       passing.erase(std::remove(passing.begin(), passing.end(), static_cast<int>(r)), passing.end());
-      if (mn >= opt.min_gain) passing.push_back(static_cast<int>(r));
+      if (summary.worst >= opt.min_gain) passing.push_back(static_cast<int>(r));
     };
     // Refit the best-screened, distinct effects first (confirmation_picks). A scope the
     // screen ranked lower is not lost: the beside-refits below refit the shared scope of a
@@ -664,11 +678,8 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     }
     // The best passing candidate; a simpler one (fewer parameters) wins if its remaining
     // held-out error is within min_gain of the best's (detail::pick_winner).
-    auto n_params = [&](int r) {
-      return effect_base(cands[score_cand[static_cast<std::size_t>(r)]].effect).params.size();
-    };
-    std::vector<Eigen::Index> sizes;
-    for (std::size_t r = 0; r < scores.size(); ++r) sizes.push_back(n_params(static_cast<int>(r)));
+    std::vector<Eigen::Index> sizes;  // parameters of each candidate
+    for (std::size_t r = 0; r < scores.size(); ++r) sizes.push_back(effect_base(cands[score_cand[r]].effect).params.size());
     auto winner = [&] {
       std::vector<double> cv;
       for (const auto& s : scores) cv.push_back(s.cv_gain);
@@ -712,13 +723,9 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       for (std::size_t r = 0; r < scores.size(); ++r) {
         if (!scores[r].confirmed) continue;
         scores[r].fold_gains = detail::measured_gains(fold_trials[r], folds);
-        double sum = 0, mn = std::numeric_limits<double>::infinity();
-        for (double g : scores[r].fold_gains) {
-          sum += g;
-          mn = std::min(mn, g);
-        }
-        scores[r].cv_gain = sum / static_cast<double>(scores[r].fold_gains.size());
-        if (mn >= opt.min_gain) passing.push_back(static_cast<int>(r));
+        const detail::GainSummary summary = detail::summarise(scores[r].fold_gains);
+        scores[r].cv_gain = summary.mean;
+        if (summary.worst >= opt.min_gain) passing.push_back(static_cast<int>(r));
       }
       best = winner();
     }
@@ -749,7 +756,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     a.evidence += " in the " + std::to_string(w.fold_gains.size()) +
                   " folds against the model without it (fold models fitted on their own training blocks)";
     for (int r : passing) {
-      if (r == best || n_params(r) != n_params(best)) continue;
+      if (r == best || sizes[static_cast<std::size_t>(r)] != sizes[static_cast<std::size_t>(best)]) continue;
       const CandidateScore& o = scores[static_cast<std::size_t>(r)];
       bool same = o.fold_gains.size() == w.fold_gains.size();
       for (std::size_t f = 0; same && f < w.fold_gains.size(); ++f)
