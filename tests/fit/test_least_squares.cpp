@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <softrne/fit/least_squares.hpp>
+#include "../gauss.hpp"
 
 namespace {
 
@@ -24,15 +25,7 @@ using softrne::fit::ParameterSet;
 using softrne::fit::ResidualFactory;
 using softrne::fit::ResidualFn;
 
-// Platform-independent N(0,1) from raw mt19937_64 bits (Box-Muller).
-struct Gauss {
-  explicit Gauss(std::uint64_t seed) : gen(seed) {}
-  double uniform() { return (static_cast<double>(gen() >> 11) + 0.5) * 0x1.0p-53; }
-  double operator()() {
-    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * M_PI * uniform());
-  }
-  std::mt19937_64 gen;
-};
+using softrne::test::Gauss;
 
 void expect_no_nan(const FitResult& r) {
   EXPECT_FALSE(r.params.hasNaN());

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <softrne/signals/savitzky_golay.hpp>
+#include "../gauss.hpp"
 
 namespace {
 
@@ -15,15 +16,7 @@ using softrne::signals::savgol;
 using softrne::signals::savgol_weights;
 using softrne::signals::SgOptions;
 
-// Platform-independent N(0,1) from raw mt19937_64 bits (Box-Muller).
-struct Gauss {
-  explicit Gauss(std::uint64_t seed) : gen(seed) {}
-  double uniform() { return (static_cast<double>(gen() >> 11) + 0.5) * 0x1.0p-53; }
-  double operator()() {
-    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * M_PI * uniform());
-  }
-  std::mt19937_64 gen;
-};
+using softrne::test::Gauss;
 
 // y = sum_q c_q t^q and its derivatives.
 struct Poly {
