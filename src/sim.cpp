@@ -6,3 +6,4 @@
 #include "softrne/arm/arm_dynamics.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 #include "softrne/sim/arm_jacobian.hpp"
+#include "softrne/sim/linearisation.hpp"
