@@ -39,7 +39,6 @@ int main() {
 
   using Vec = decltype(arm)::VectorQ;
   Vec q, qd, qdd, tau;
-  const double dA = 0.06 * M_PI * 0.03 * 0.03;
   const double bias = 5e3;  // Pa in both chambers of a pair: some co-contraction
   Eigen::Matrix<double, 12, 1> p;
   double p_max = 0;
@@ -57,10 +56,10 @@ int main() {
     tau.segment<2>(0) -= std::get<0>(arm.segments).passive_force(q.segment<2>(0), qd.segment<2>(0));
     tau.segment<2>(2) -= std::get<2>(arm.segments).passive_force(q.segment<2>(2), qd.segment<2>(2));
     tau.segment<2>(4) -= std::get<4>(arm.segments).passive_force(q.segment<2>(4), qd.segment<2>(4));
-    for (int j = 0; j < 6; ++j) {  // coordinate j -> chambers (2j, 2j+1)
-      p(2 * j) = bias + std::max(tau(j), 0.0) / dA;
-      p(2 * j + 1) = bias + std::max(-tau(j), 0.0) / dA;
-    }
+    // Each joint's torques -> its four chambers (pressure_allocation.hpp).
+    softrne::antagonistic_pressures(joint.pressure_to_torque, tau.segment<2>(0), bias, p.segment<4>(0));
+    softrne::antagonistic_pressures(joint.pressure_to_torque, tau.segment<2>(2), bias, p.segment<4>(4));
+    softrne::antagonistic_pressures(joint.pressure_to_torque, tau.segment<2>(4), bias, p.segment<4>(8));
     p_max = std::max(p_max, p.maxCoeff());
     if (k % 50 == 0) {
       Eigen::internal::set_is_malloc_allowed(true);  // printing is outside the control law

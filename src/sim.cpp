@@ -5,3 +5,6 @@
 #include "softrne/arm/arm_description.hpp"
 #include "softrne/arm/arm_dynamics.hpp"
 #include "softrne/sim/arm_simulation.hpp"
+#include "softrne/sim/arm_jacobian.hpp"
+#include "softrne/sim/closed_loop.hpp"
+#include "softrne/sim/linearisation.hpp"

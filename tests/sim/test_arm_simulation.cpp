@@ -22,6 +22,7 @@
 #include "softrne/io/robot_spec.hpp"
 #include "softrne/signals/pchip.hpp"
 #include "softrne/sim/arm_simulation.hpp"
+#include "test_arms.hpp"
 
 #if __has_include(<nlohmann/json.hpp>)
 #include "softrne/io/robot_json.hpp"
@@ -29,6 +30,9 @@
 #endif
 
 namespace {
+
+using softrne::test::link;
+using softrne::test::three_joint_arm;
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -44,17 +48,6 @@ using PI = ArmSimulationOptions::PressureInterpolation;
 
 // ---- robots built in code -------------------------------------------------------------
 
-softrne::io::RigidLinkSpec link(const std::string& name, double mass, double length, double com_z,
-                                double ixx, double izz) {
-  softrne::io::RigidLinkSpec l;
-  l.name = name;
-  l.mass = mass;
-  l.length = length;
-  l.com = Eigen::Vector3d(0, 0, com_z);
-  l.inertia = Eigen::Vector3d(ixx, ixx, izz).asDiagonal();
-  return l;
-}
-
 /// CC joint, link, CC joint, link; gravity as given.
 RobotSpec two_joint_arm(const Eigen::Vector3d& gravity, double damping_scale = 1.0) {
   using softrne::io::make_cc_joint;
@@ -68,23 +61,6 @@ RobotSpec two_joint_arm(const Eigen::Vector3d& gravity, double damping_scale = 1
                                      Eigen::Vector2d(22, 18),
                                      damping_scale * Eigen::Vector2d(1.2, 1.0)));
   s.segments.push_back(link("link2", 0.4, 0.05, 0.025, 0.0004, 0.0005));
-  return s;
-}
-
-/// The bundled arm's layout (three CC joints with links), hanging, in code.
-RobotSpec three_joint_arm() {
-  using softrne::io::make_cc_joint;
-  RobotSpec s;
-  s.name = "three-joint test arm";
-  s.gravity = Eigen::Vector3d(0, 0, 9.81);
-  for (int j = 1; j <= 3; ++j) {
-    s.segments.push_back(make_cc_joint("joint" + std::to_string(j), 0.8, 0.2, 0.2, 0.06, 0.03,
-                                       Eigen::Vector2d(20 + 3 * j, 30 - 4 * j),
-                                       Eigen::Vector2d(2.0, 1.5 + 0.3 * j)));
-    s.segments.push_back(link("link" + std::to_string(j), j == 3 ? 0.4 : 1.5, j == 3 ? 0.05 : 0.15,
-                              j == 3 ? 0.025 : 0.075, j == 3 ? 3.3e-4 : 5.2e-3,
-                              j == 3 ? 5e-4 : 4.8e-3));
-  }
   return s;
 }
 

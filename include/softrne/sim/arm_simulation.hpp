@@ -22,15 +22,14 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <unsupported/Eigen/AutoDiff>
 
 #include "softrne/config.hpp"
-#include "softrne/algorithms/rnea.hpp"
 #include "softrne/arm/arm_dynamics.hpp"
 #include "softrne/signals/input_signal.hpp"
 #include "softrne/signals/jumps.hpp"
 #include "softrne/signals/pchip.hpp"
 #include "softrne/signals/smoothing.hpp"
+#include "softrne/sim/arm_jacobian.hpp"
 #include "softrne/sim/cvode.hpp"
 
 namespace softrne::sim {
@@ -57,8 +56,8 @@ struct ArmSimulationOptions {
   /// Jacobian of the state equation by forward-mode AutoDiff through the templated RNE
   /// (exact); false: CVODE's internal finite differences.
   bool autodiff_jacobian = true;
-  /// How the AutoDiff Jacobian is formed (both exact; see ArmSystem::JacobianMethod).
-  enum class JacobianMethod { inverse_dynamics, forward_dynamics };
+  /// How the AutoDiff Jacobian is formed (both exact; see sim::JacobianMethod).
+  using JacobianMethod = sim::JacobianMethod;
   JacobianMethod jacobian_method = JacobianMethod::inverse_dynamics;  ///< the cheaper one
 
   /// Absolute tolerance of the velocities = cvode.atol * velocity_atol_factor (1/s): a
@@ -96,25 +95,12 @@ struct ArmSimulation {
 };
 
 /// \brief The arm as an ODE system for CVODE: x' = f(t, x) with the interpolated recorded
-/// pressures, and its exact Jacobian by AutoDiff (blocks of kBlock directions at a time).
+/// pressures, and its exact Jacobian by AutoDiff (ArmJacobian).
 class ArmSystem {
  public:
-  /// Derivative directions per AutoDiff pass. 2 (one SSE register) measured fastest for the
-  /// 12-state bundled arm: 0.43M instructions per Jacobian against 0.67M with 4, 0.73M with 12.
-  static constexpr int kBlock = 2;
-  using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, kBlock, 1>>;  ///< kBlock directions
-  using ADVector = Eigen::Matrix<AD, Eigen::Dynamic, 1>;  ///< a state of AD scalars
-
   /// \brief How jacobian() differentiates the acceleration rows; both are exact (AutoDiff).
-  /// - inverse_dynamics: \f$\partial\ddot q/\partial x = M^{-1}(\partial\tau/\partial x -
-  ///   \partial\,\mathrm{ID}(q,\dot q,\ddot q^*)/\partial x)\f$ at the current acceleration
-  ///   \f$\ddot q^*\f$, with ID the chain's RNE (M qddot + C qdot + G) and tau every other
-  ///   force (pressures, springs, dampers, effects). AutoDiff runs through one kinematics pass
-  ///   and one RNE pass per block; M's Cholesky factor comes from a double evaluation. 1.3 to
-  ///   2 times cheaper than differentiating forward dynamics (the default).
-  /// - forward_dynamics: AutoDiff through the whole right-hand side (kinematics, nq + 1 RNE
-  ///   passes, Cholesky).
-  using JacobianMethod = ArmSimulationOptions::JacobianMethod;
+  /// See sim::JacobianMethod.
+  using JacobianMethod = sim::JacobianMethod;
 
   /// \brief The system of `desc` driven by the recorded pressures.
   /// \param desc the arm; it must outlive the system
@@ -134,9 +120,9 @@ class ArmSystem {
   void set_progress(const std::function<void(double)>* f) { progress_ = f && *f ? f : nullptr; }
   /// \brief Chooses how jacobian() differentiates.
   /// \param[in] m The method.
-  void set_jacobian_method(JacobianMethod m) { method_ = m; }
+  void set_jacobian_method(JacobianMethod m) { f_.set_method(m); }
   /// \return How jacobian() differentiates.
-  JacobianMethod jacobian_method() const { return method_; }
+  JacobianMethod jacobian_method() const { return f_.method(); }
 
   /// \brief Called by integrate() before each segment between breakpoints: a zero-order-hold
   /// input gives at the segment's end the value held before the jump there (see cvode.hpp).
@@ -164,7 +150,10 @@ class ArmSystem {
   /// \param[in] x The state (q, qdot, effect states).
   /// \param[out] xdot Its time derivative.
   /// \return False if xdot is not finite.
-  bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> xdot);
+  bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> xdot) {
+    if (progress_ && (++rhs_calls_ & 63u) == 0) (*progress_)(t);
+    return f_.rhs(x, pressures(t), xdot);
+  }
 
   /// \brief The exact Jacobian df/dx by AutoDiff (JacobianMethod).
   /// \param[in] t Time, s.
@@ -172,26 +161,18 @@ class ArmSystem {
   /// \param[out] J df/dx, size() x size().
   /// \return False if J is not finite.
   bool jacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J);
+                const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::MatrixXd> J) {
+    return f_.state_jacobian(x, pressures(t), J);
+  }
 
  private:
-  // Seeds x_ad_ with the value x and unit derivatives for states [start, start + kBlock).
-  void seed(const Eigen::Ref<const Eigen::VectorXd>& x, int start);
-  bool jacobian_forward(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J);
-  bool jacobian_inverse(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::MatrixXd> J);
-
   const ArmDescription& desc_;
-  ArmDynamics<double> f_;
-  ArmDynamics<AD> f_ad_;
+  ArmJacobian f_;
   ArmSimulationOptions::PressureInterpolation mode_;
   InputSignal input_;
   PchipSignal pchip_;
   SignalCursor cursor_;
   Eigen::VectorXd p_;
-  ADVector x_ad_, xd_ad_, q_ad_, v_ad_, a_ad_, p_ad_;
-  Eigen::VectorXd xdot_;
-  Eigen::Matrix<double, Eigen::Dynamic, kBlock> dr_;
-  JacobianMethod method_ = JacobianMethod::inverse_dynamics;
   double delay_ = 0;
   double segment_end_ = std::numeric_limits<double>::infinity();
   const std::function<void(double)>* progress_ = nullptr;
@@ -199,15 +180,11 @@ class ArmSystem {
 };
 
 #if SOFTRNE_SIM_BODIES
-// ArmSystem's members that run the dynamics (double and AutoDiff): compiled once in src/sim.cpp
-// for the targets that link softrne::sim_compiled, inline otherwise (config.hpp). Defined in
-// the class, they were instantiated in every translation unit that included this header.
 SOFTRNE_SIM_INLINE ArmSystem::ArmSystem(const ArmDescription& desc, const Eigen::VectorXd& t,
                                         const Eigen::MatrixXd& pressures,
                                         ArmSimulationOptions::PressureInterpolation mode)
     : desc_(desc),
       f_(desc),
-      f_ad_(desc),
       mode_(mode),
       input_(t, pressures,
              mode == ArmSimulationOptions::PressureInterpolation::zero_order_hold
@@ -215,93 +192,7 @@ SOFTRNE_SIM_INLINE ArmSystem::ArmSystem(const ArmDescription& desc, const Eigen:
                  : Interpolation::linear),
       pchip_(t, pressures),
       delay_(desc.input_delay()) {
-  const int nq = desc.nq, ns = desc.num_states();
   p_.resize(desc.num_inputs);
-  x_ad_.resize(ns);
-  xd_ad_.resize(ns);
-  q_ad_.resize(nq);
-  v_ad_.resize(nq);
-  a_ad_.resize(nq);
-  p_ad_.resize(desc.num_inputs);
-  xdot_.resize(ns);
-  dr_.resize(nq, kBlock);
-}
-
-SOFTRNE_SIM_INLINE bool ArmSystem::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                                        Eigen::Ref<Eigen::VectorXd> xdot) {
-  if (progress_ && (++rhs_calls_ & 63u) == 0) (*progress_)(t);
-  pressures(t);
-  f_.rhs(x, p_, xdot);
-  return xdot.allFinite();
-}
-
-SOFTRNE_SIM_INLINE bool ArmSystem::jacobian(double t, const Eigen::Ref<const Eigen::VectorXd>& x,
-                                             const Eigen::Ref<const Eigen::VectorXd>&,
-                                             Eigen::Ref<Eigen::MatrixXd> J) {
-  pressures(t);
-  if (method_ == JacobianMethod::forward_dynamics) return jacobian_forward(x, J);
-  return jacobian_inverse(x, J);
-}
-
-SOFTRNE_SIM_INLINE void ArmSystem::seed(const Eigen::Ref<const Eigen::VectorXd>& x, int start) {
-  const int n = size();
-  for (int i = 0; i < n; ++i) {
-    x_ad_(i).value() = x(i);
-    x_ad_(i).derivatives().setZero();
-    if (i >= start && i < start + kBlock) x_ad_(i).derivatives()(i - start) = 1.0;
-  }
-}
-
-SOFTRNE_SIM_INLINE bool ArmSystem::jacobian_forward(const Eigen::Ref<const Eigen::VectorXd>& x,
-                                                     Eigen::Ref<Eigen::MatrixXd> J) {
-  const int n = size();
-  for (int start = 0; start < n; start += kBlock) {
-    seed(x, start);
-    f_ad_.rhs(x_ad_, p_, xd_ad_);
-    for (int i = 0; i < n; ++i)
-      for (int k = 0; k < kBlock && start + k < n; ++k)
-        J(i, start + k) = xd_ad_(i).derivatives()(k);
-  }
-  return J.allFinite();
-}
-
-SOFTRNE_SIM_INLINE bool ArmSystem::jacobian_inverse(const Eigen::Ref<const Eigen::VectorXd>& x,
-                                                     Eigen::Ref<Eigen::MatrixXd> J) {
-  const ArmDescription& d = desc_;
-  const int nq = d.nq, n = size(), nz = d.num_effect_states;
-  // Double evaluation: the acceleration qddot* and M's Cholesky factor at x.
-  f_.rhs(x, p_, xdot_);
-  if (!xdot_.allFinite()) return false;
-  const Eigen::MatrixXd& L = f_.data().mass_factor;  // Cholesky factor in the lower triangle
-  const auto& qdd = f_.data().qddot;
-  for (int i = 0; i < nq; ++i) {
-    a_ad_(i).value() = qdd(i);
-    a_ad_(i).derivatives().setZero();
-  }
-  // d qdot / d qdot = I; d qdot / d (q, z) = 0 (J arrives zeroed from CVODE; not from tests).
-  J.topRows(nq).setZero();
-  J.block(0, nq, nq, nq).setIdentity();
-  for (int start = 0; start < n; start += kBlock) {
-    const int cols = std::min(kBlock, n - start);
-    seed(x, start);
-    q_ad_ = x_ad_.head(nq);
-    v_ad_ = x_ad_.segment(nq, nq);
-    const auto xs = x_ad_.segment(2 * nq, nz);
-    f_ad_.effective_pressures(xs, p_, p_ad_);
-    const auto& tau = f_ad_.joint_forces(q_ad_, v_ad_, p_ad_, xs);
-    const auto& id = rnea(f_ad_.chain(), f_ad_.data(), q_ad_, v_ad_, a_ad_);
-    for (int i = 0; i < nq; ++i)
-      for (int k = 0; k < kBlock; ++k)
-        dr_(i, k) = tau(i).derivatives()(k) - id(i).derivatives()(k);
-    L.triangularView<Eigen::Lower>().solveInPlace(dr_);
-    L.transpose().triangularView<Eigen::Upper>().solveInPlace(dr_);
-    J.block(nq, start, nq, cols) = dr_.leftCols(cols);
-    // Effect states: differentiate their own derivative (it may depend on q and qdot).
-    f_ad_.effect_state_derivative(xs, q_ad_, v_ad_, p_, xd_ad_.segment(2 * nq, nz));
-    for (int i = 2 * nq; i < n; ++i)
-      for (int k = 0; k < cols; ++k) J(i, start + k) = xd_ad_(i).derivatives()(k);
-  }
-  return J.allFinite();
 }
 #endif  // SOFTRNE_SIM_BODIES
 
@@ -318,6 +209,13 @@ class ScaledSystem {
   int size() const { return static_cast<int>(s_.size()); }
   void set_segment(std::size_t k, double t_begin, double t_end) {
     sys_.set_segment(k, t_begin, t_end);
+  }
+  // The state form, if the system has it (integrate() prefers it): the unscaled state.
+  template <class Y, class Sys = System,
+            std::enable_if_t<has_set_segment_state<Sys>::value, int> = 0>
+  void set_segment(std::size_t k, double t_begin, double t_end, const Y& y) {
+    x_ = s_.cwiseProduct(y);
+    sys_.set_segment(k, t_begin, t_end, ConstVectorMap(x_.data(), x_.size()));
   }
 
   bool rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
@@ -343,6 +241,34 @@ class ScaledSystem {
   Eigen::VectorXd s_, x_, f_;
   Eigen::MatrixXd J_;
 };
+
+/// \brief integrate() of an arm's system (ArmSystem or another with the arm's state layout)
+/// with the velocities' absolute tolerance scaled by `velocity_atol_factor` (see
+/// ArmSimulationOptions); the result's states are unscaled.
+template <class System>
+SimulationResult integrate_arm(System& sys, const Eigen::VectorXd& x0, const Eigen::VectorXd& t,
+                               const std::vector<double>& breakpoints, const CvodeOptions& copt,
+                               double velocity_atol_factor) {
+  const ArmDescription& desc = sys.description();
+  const double vf = velocity_atol_factor;
+  if (!(vf > 0 && vf != 1.0 && std::isfinite(vf))) return integrate(sys, x0, t, breakpoints, copt);
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(desc.num_states());
+  scale.segment(desc.nq, desc.nq).setConstant(vf);
+  ScaledSystem<System> scaled(sys, scale);
+  SimulationResult r = integrate(scaled, x0.cwiseQuotient(scale), t, breakpoints, copt);
+  r.x = r.x * scale.asDiagonal();
+  return r;
+}
+
+/// \brief What the sensors report for each row of simulated states: y = gain .* q + offset
+/// (sensor_gain, angle_offset).
+inline Eigen::MatrixXd measured_angles(const ArmDescription& desc, const Eigen::MatrixXd& states) {
+  Eigen::VectorXd gain, offset;
+  desc.measurement(gain, offset);
+  Eigen::MatrixXd y = states.leftCols(desc.nq) * gain.asDiagonal();
+  if (y.rows() > 0) y.rowwise() += offset.transpose();
+  return y;
+}
 
 }  // namespace detail
 
@@ -385,23 +311,9 @@ SOFTRNE_SIM_INLINE ArmSimulation simulate_arm(const ArmDescription& desc, const 
   // A delayed input jumps later (integrate drops breakpoints past the end).
   for (double& b : bp) b += sys.input_delay();
 
-  const double vf = opt.velocity_atol_factor;
-  if (vf > 0 && vf != 1.0 && std::isfinite(vf)) {
-    Eigen::VectorXd scale = Eigen::VectorXd::Ones(desc.num_states());
-    scale.segment(desc.nq, desc.nq).setConstant(vf);
-    detail::ScaledSystem<ArmSystem> scaled(sys, scale);
-    out.result = integrate(scaled, x0.cwiseQuotient(scale), t, bp, copt);
-    out.result.x = out.result.x * scale.asDiagonal();
-  } else {
-    out.result = integrate(sys, x0, t, bp, copt);
-  }
+  out.result = detail::integrate_arm(sys, x0, t, bp, copt, opt.velocity_atol_factor);
   out.states = out.result.x;
-  const Eigen::Index rows = out.states.rows();
-  // What the sensors report: y = gain .* q + offset (sensor_gain, angle_offset).
-  Eigen::VectorXd gain, offset;
-  desc.measurement(gain, offset);
-  out.angles = out.states.leftCols(desc.nq) * gain.asDiagonal();
-  if (rows > 0) out.angles.rowwise() += offset.transpose();
+  out.angles = detail::measured_angles(desc, out.states);
   return out;
 }
 #else

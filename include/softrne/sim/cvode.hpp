@@ -15,7 +15,11 @@
 ///                 const Eigen::Ref<const Eigen::VectorXd>& f,
 ///                 Eigen::Ref<Eigen::MatrixXd> J);           // or void
 ///   // optional, detected: called before integrating each segment between
-///   // breakpoints, segment k spanning [t_begin, t_end] (either form)
+///   // breakpoints, segment k spanning [t_begin, t_end] (one of the forms; the
+///   // first receives the state at t_begin: a controller sampled at the
+///   // breakpoints, sim/closed_loop.hpp)
+///   void set_segment(std::size_t k, double t_begin, double t_end,
+///                    const Eigen::Ref<const Eigen::VectorXd>& x);
 ///   void set_segment(std::size_t k, double t_begin, double t_end);
 ///   void set_segment(std::size_t k);
 /// \endcode
@@ -138,6 +142,14 @@ template <class S>
 struct has_jacobian<S, std::void_t<decltype(std::declval<S&>().jacobian(
                            0.0, std::declval<const ConstVectorMap&>(),
                            std::declval<const ConstVectorMap&>(), std::declval<MatrixMap&>()))>>
+    : std::true_type {};
+
+template <class S, class = void>
+struct has_set_segment_state : std::false_type {};
+template <class S>
+struct has_set_segment_state<
+    S, std::void_t<decltype(std::declval<S&>().set_segment(std::size_t{0}, 0.0, 0.0,
+                                                           std::declval<const ConstVectorMap&>()))>>
     : std::true_type {};
 
 template <class S, class = void>
@@ -489,7 +501,9 @@ SimulationResult integrate(System& sys, const Eigen::VectorXd& x0,
 
   std::size_t segment = 0;  // index into stops: the current segment ends at stops[segment]
   auto announce_segment = [&](double t_begin) {
-    if constexpr (detail::has_set_segment_window<System>::value)
+    if constexpr (detail::has_set_segment_state<System>::value)
+      sys.set_segment(segment, t_begin, stops[segment], detail::ConstVectorMap(y_map.data(), n));
+    else if constexpr (detail::has_set_segment_window<System>::value)
       sys.set_segment(segment, t_begin, stops[segment]);
     else if constexpr (detail::has_set_segment_index<System>::value)
       sys.set_segment(segment);
