@@ -16,3 +16,4 @@
 #include "softrne/algorithms/forward_dynamics.hpp"
 #include "softrne/algorithms/own_inertia.hpp"
 #include "softrne/algorithms/articulated_body.hpp"
+#include "softrne/algorithms/derivatives.hpp"
