@@ -19,8 +19,14 @@
 /// - two directions fill one SSE register: measured fastest for the simulator's Jacobian
 ///   (sim::ArmSystem, 0.43M instructions against 0.67M with 4 and 0.73M with 12 directions);
 ///   one AD type serves every chain size and both chain kinds (compile time).
-/// The price is the cost: nq passes, each a few times a double RNE (docs/performance.md and
-/// bench/softrne_bench.cpp, `*/rnea_derivatives` against `*/rnea`).
+/// The price is the cost: nq passes, each about 4.5 double RNEs (Eigen's AutoDiffScalar
+/// evaluates every operation on the value and both derivatives, with temporaries). Measured
+/// (docs/performance.md, bench `*/rnea_derivatives` against `*/rnea`, same run): 28x rnea on
+/// the paper's arm, 24x on 6 revolute joints, 123x on 30 (O(nq) passes of O(n)); the goal of
+/// 4x on the paper's arm is not met. Tried and dropped: computing each pass's kinematics only
+/// for the one segment whose coordinates it seeds (a segment's kinematics depend on its own
+/// coordinates only): 15 % faster on the arm, 12-20 % slower on 6 revolute joints; the AD
+/// recursions, not the kinematics, dominate. The goal needs the analytical recursion below.
 ///
 /// ## What an analytical recursion would need
 /// Pinocchio's computeRNEADerivatives differentiates the recursion itself: one forward pass
@@ -44,6 +50,7 @@
 
 #include <limits>
 #include <type_traits>
+#include <variant>
 
 #include <Eigen/Core>
 

@@ -48,7 +48,7 @@ namespace detail {
 /// \brief Seeds one AutoDiff pass: out(i) = value(i) with derivative direction
 /// `index + i - start` of the pass if that lies in [0, kDerivativeBlock), else none. A vector
 /// holding the variables [index, index + size) of a pass over [start, start + kDerivativeBlock)
-/// (rnea_derivatives: q at index 0, qdot at nq; sim::ArmSystem: the whole state at 0).
+/// (rnea_derivatives: q at index 0, qdot at nq).
 template <class V, class VAD>
 void seed_block(const Eigen::MatrixBase<V>& value, int index, int start, VAD& out) {
   for (Eigen::Index i = 0; i < value.size(); ++i) {

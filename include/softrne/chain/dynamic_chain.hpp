@@ -208,9 +208,10 @@ struct DynamicChainData {
   /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial\dot q\f$.
   /// \var dqddot_dtau
   /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial\tau = M^{-1}\f$.
-  /// Scratch of the derivatives: the chain in an AutoDiff scalar and its workspace, built by
-  /// the first call (allocated once then).
   DerivativeWorkspace<DynamicChain<Scalar>> derivatives;
+  /// \var derivatives
+  /// \brief Scratch of the derivatives: the chain in an AutoDiff scalar and its workspace, built
+  /// by the first call (allocated once then).
 
   DynamicChainData() = default;
   /// \brief Sized for `chain` (what chain.make_data() returns).

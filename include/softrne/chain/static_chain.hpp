@@ -183,9 +183,10 @@ struct ChainData<Chain<Segments...>> {
   /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial\dot q\f$.
   /// \var dqddot_dtau
   /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial\tau = M^{-1}\f$.
-  /// Scratch of the derivatives: the chain in an AutoDiff scalar and its workspace (fixed
-  /// size: no heap).
   DerivativeWorkspace<ChainT> derivatives;
+  /// \var derivatives
+  /// \brief Scratch of the derivatives: the chain in an AutoDiff scalar and its workspace (fixed
+  /// size: no heap).
 
   ChainData() = default;
   /// \brief Zero-initialised (what chain.make_data() returns); the chain's type sizes it.
