@@ -12,7 +12,8 @@
 //   sim/arm-a-1/{train,test}[/atol1e-08]   CVODE simulation (softrne::sim::simulate_arm) of
 //                                          examples/data/arm-a-1/<split>.csv, default options
 //                                          [or absolute tolerance 1e-8]
-// with <algo> in rnea, gravity, bias, mass_matrix, forward_dynamics, aba and <fn> in rnea,
+// with <algo> in rnea, gravity, bias, mass_matrix, forward_dynamics, aba, rnea_derivatives,
+// aba_derivatives (algorithms/derivatives.hpp) and <fn> in rnea,
 // gravity (computeGeneralizedGravity), bias (nonLinearEffects), crba, aba.
 //
 // Every call goes through a non-inlined wrapper (as Pinocchio's benchmark/timings.cpp does)
@@ -242,6 +243,21 @@ SOFTRNE_BENCH_NOINLINE const typename ChainT::VectorQ& call_aba(
   return aba(c, d, q, qd, tau);
 }
 
+template <class ChainT>
+SOFTRNE_BENCH_NOINLINE const typename ChainT::MatrixQ& call_rnea_derivatives(
+    const ChainT& c, typename ChainT::Data& d, const typename ChainT::VectorQ& q,
+    const typename ChainT::VectorQ& qd, const typename ChainT::VectorQ& qdd) {
+  rnea_derivatives(c, d, q, qd, qdd);
+  return d.dtau_dq;
+}
+template <class ChainT>
+SOFTRNE_BENCH_NOINLINE const typename ChainT::MatrixQ& call_aba_derivatives(
+    const ChainT& c, typename ChainT::Data& d, const typename ChainT::VectorQ& q,
+    const typename ChainT::VectorQ& qd, const typename ChainT::VectorQ& tau) {
+  aba_derivatives(c, d, q, qd, tau);
+  return d.dqddot_dq;
+}
+
 enum Algo : unsigned {
   kRnea = 1,
   kGravity = 2,
@@ -249,7 +265,9 @@ enum Algo : unsigned {
   kMassMatrix = 8,
   kForwardDynamics = 16,
   kAba = 32,  // O(n) forward dynamics (articulated_body.hpp)
-  kAll = 63
+  kRneaDerivatives = 64,  // derivatives.hpp
+  kAbaDerivatives = 128,
+  kAll = 255
 };
 
 benchmark::TimeUnit unit_for(double expected_ns) {
@@ -306,6 +324,16 @@ void register_chain(const std::string& prefix, const std::string& suffix,
   if (which & kAba)
     reg("aba", 2.5, [](Fix& x, unsigned k) {
       benchmark::DoNotOptimize(call_aba(x.chain, x.data, x.q[k], x.qd[k], x.tau[k]).data());
+    });
+  if (which & kRneaDerivatives)
+    reg("rnea_derivatives", 4.0 * nq, [](Fix& x, unsigned k) {
+      benchmark::DoNotOptimize(
+          call_rnea_derivatives(x.chain, x.data, x.q[k], x.qd[k], x.qdd[k]).data());
+    });
+  if (which & kAbaDerivatives)
+    reg("aba_derivatives", 4.0 * nq, [](Fix& x, unsigned k) {
+      benchmark::DoNotOptimize(
+          call_aba_derivatives(x.chain, x.data, x.q[k], x.qd[k], x.tau[k]).data());
     });
 }
 
@@ -578,6 +606,15 @@ class SummaryReporter : public benchmark::ConsoleReporter {
     for (const std::string m : {"arm/static", "arm/dynamic", "rev6/static", "rev6/dynamic",
                                 "rev30/dynamic"})
       ratio(m + ": forward_dynamics / aba", m + "/forward_dynamics", m + "/aba");
+    // Derivatives (derivatives.hpp) against the RNE itself (target: rnea_derivatives <= 4 x
+    // rnea on the paper's arm) and against the forward dynamics.
+    for (const std::string m : {"arm/static", "arm/dynamic", "rev6/static", "rev6/dynamic",
+                                "rev30/dynamic"}) {
+      ratio(m + ": rnea_derivatives / rnea", m + "/rnea_derivatives", m + "/rnea");
+      ratio(m + ": aba_derivatives / rnea", m + "/aba_derivatives", m + "/rnea");
+      ratio(m + ": aba_derivatives / forward_dynamics", m + "/aba_derivatives",
+            m + "/forward_dynamics");
+    }
     for (int n : {1, 3, 10, 30, 100, 300})
       ratio("cc/dynamic/" + std::to_string(n) + ": forward_dynamics / aba",
             "cc/dynamic/forward_dynamics/" + std::to_string(n),

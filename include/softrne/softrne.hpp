@@ -17,3 +17,4 @@
 #include "softrne/algorithms/own_inertia.hpp"
 #include "softrne/algorithms/articulated_body.hpp"
 #include "softrne/algorithms/pressure_allocation.hpp"
+#include "softrne/algorithms/derivatives.hpp"

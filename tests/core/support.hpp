@@ -65,6 +65,40 @@ inline softrne::DynamicChain<double> paper_arm() {
   return c;
 }
 
+/// Uniform random number in [lo, hi].
+inline double uniform(std::mt19937& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+/// A CC joint of random mass and dimensions (any inertia model).
+template <class Inertia = softrne::LumpedInertia>
+softrne::ConstantCurvatureJoint<double, Inertia> random_cc(std::mt19937& rng) {
+  softrne::ConstantCurvatureJoint<double, Inertia> c;
+  c.mass = uniform(rng, 0.2, 1.5);
+  c.height = uniform(rng, 0.08, 0.3);
+  c.diameter = uniform(rng, 0.04, 0.25);
+  return c;
+}
+
+/// A rigid link with a full inertia tensor and its centre of mass off the axis.
+inline softrne::RigidLink<double> random_link(std::mt19937& rng) {
+  softrne::RigidLink<double> l;
+  l.mass = uniform(rng, 0.1, 2.0);
+  l.length = uniform(rng, 0.02, 0.3);
+  l.com = Eigen::Vector3d(uniform(rng, -0.05, 0.05), uniform(rng, -0.05, 0.05), uniform(rng, 0, l.length));
+  Eigen::Matrix3d A;
+  for (int i = 0; i < 9; ++i) A(i / 3, i % 3) = uniform(rng, -0.05, 0.05);
+  l.inertia = l.mass * (A * A.transpose() + 1e-3 * Eigen::Matrix3d::Identity());
+  return l;
+}
+
+/// A revolute joint about a random axis.
+inline softrne::RevoluteJoint<double> random_rev(std::mt19937& rng) {
+  softrne::RevoluteJoint<double> r;
+  r.axis = Eigen::Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)).normalized();
+  return r;
+}
+
 /// Max |a - b| / max(1, |b|_inf).
 inline double rel_err(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());

@@ -33,35 +33,10 @@ using Rev = RevoluteJoint<double>;
 
 enum Kind { kCC = 0, kLink = 1, kRev = 2 };
 
-double uniform(std::mt19937& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-
-CC random_cc(std::mt19937& rng) {
-  CC c;
-  c.mass = uniform(rng, 0.2, 1.5);
-  c.height = uniform(rng, 0.08, 0.3);
-  c.diameter = uniform(rng, 0.04, 0.25);
-  return c;
-}
-
-/// Full inertia tensor, centre of mass off the axis.
-Link random_link(std::mt19937& rng) {
-  Link l;
-  l.mass = uniform(rng, 0.1, 2.0);
-  l.length = uniform(rng, 0.02, 0.3);
-  l.com = Vector3d(uniform(rng, -0.05, 0.05), uniform(rng, -0.05, 0.05), uniform(rng, 0, l.length));
-  Matrix3d A;
-  for (int i = 0; i < 9; ++i) A(i / 3, i % 3) = uniform(rng, -0.05, 0.05);
-  l.inertia = l.mass * (A * A.transpose() + 1e-3 * Matrix3d::Identity());
-  return l;
-}
-
-Rev random_rev(std::mt19937& rng) {
-  Rev r;
-  r.axis = Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)).normalized();
-  return r;
-}
+using softrne_test::random_cc;
+using softrne_test::random_link;
+using softrne_test::random_rev;
+using softrne_test::uniform;
 
 DynamicChain<double> make_chain(const std::vector<int>& kinds, std::mt19937& rng) {
   DynamicChain<double> c;

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "softrne/chain/articulated_workspace.hpp"
+#include "softrne/chain/derivative_workspace.hpp"
 #include "softrne/chain/motion.hpp"
 #include "softrne/config.hpp"
 #include "softrne/segments/segment_list.hpp"
@@ -191,6 +192,26 @@ struct DynamicChainData {
   static constexpr int max_segment_nq = detail::variant_max_nq<AnySegment<Scalar>>::value;
   /// Per-segment scratch of aba (articulated_body.hpp), one per segment.
   std::vector<ArticulatedSegment<Scalar, max_segment_nq>> articulated;
+
+  /// Outputs of rnea_derivatives() (dtau_dq, dtau_dqdot; d tau/d qddot is mass_matrix) and of
+  /// aba_derivatives() (dqddot_dq, dqddot_dqdot, dqddot_dtau = M^-1), as Pinocchio's
+  /// dtau_dq, dtau_dv, ddq_dq, ddq_dv, Minv. Sized nq x nq by the first call (allocated once
+  /// then, so that a Data never used for derivatives does not carry five nq x nq matrices).
+  MatrixQ dtau_dq, dtau_dqdot, dqddot_dq, dqddot_dqdot, dqddot_dtau;
+  /// \var dtau_dq
+  /// \brief Output of rnea_derivatives(): \f$\partial\tau/\partial q\f$.
+  /// \var dtau_dqdot
+  /// \brief Output of rnea_derivatives(): \f$\partial\tau/\partial\dot q\f$.
+  /// \var dqddot_dq
+  /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial q\f$.
+  /// \var dqddot_dqdot
+  /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial\dot q\f$.
+  /// \var dqddot_dtau
+  /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial\tau = M^{-1}\f$.
+  DerivativeWorkspace<DynamicChain<Scalar>> derivatives;
+  /// \var derivatives
+  /// \brief Scratch of the derivatives: the chain in an AutoDiff scalar and its workspace, built
+  /// by the first call (allocated once then).
 
   DynamicChainData() = default;
   /// \brief Sized for `chain` (what chain.make_data() returns).

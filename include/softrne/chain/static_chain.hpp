@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include "softrne/chain/articulated_workspace.hpp"
+#include "softrne/chain/derivative_workspace.hpp"
 #include "softrne/chain/motion.hpp"
 #include "softrne/config.hpp"
 #include "softrne/segments/segment_concept.hpp"
@@ -168,6 +169,25 @@ struct ChainData<Chain<Segments...>> {
   /// Per-segment scratch of aba (articulated_body.hpp).
   std::array<ArticulatedSegment<Scalar, detail::max_segment_nq<Segments...>()>, N> articulated;
 
+  /// Outputs of rnea_derivatives() (dtau_dq, dtau_dqdot; d tau/d qddot is mass_matrix) and of
+  /// aba_derivatives() (dqddot_dq, dqddot_dqdot, dqddot_dtau = M^-1), as Pinocchio's
+  /// dtau_dq, dtau_dv, ddq_dq, ddq_dv, Minv.
+  typename ChainT::MatrixQ dtau_dq, dtau_dqdot, dqddot_dq, dqddot_dqdot, dqddot_dtau;
+  /// \var dtau_dq
+  /// \brief Output of rnea_derivatives(): \f$\partial\tau/\partial q\f$.
+  /// \var dtau_dqdot
+  /// \brief Output of rnea_derivatives(): \f$\partial\tau/\partial\dot q\f$.
+  /// \var dqddot_dq
+  /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial q\f$.
+  /// \var dqddot_dqdot
+  /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial\dot q\f$.
+  /// \var dqddot_dtau
+  /// \brief Output of aba_derivatives(): \f$\partial\ddot q/\partial\tau = M^{-1}\f$.
+  DerivativeWorkspace<ChainT> derivatives;
+  /// \var derivatives
+  /// \brief Scratch of the derivatives: the chain in an AutoDiff scalar and its workspace (fixed
+  /// size: no heap).
+
   ChainData() = default;
   /// \brief Zero-initialised (what chain.make_data() returns); the chain's type sizes it.
   explicit ChainData(const ChainT&) {
@@ -179,6 +199,11 @@ struct ChainData<Chain<Segments...>> {
     unit.setZero();
     qddot.setZero();
     mass_matrix.setZero();
+    dtau_dq.setZero();
+    dtau_dqdot.setZero();
+    dqddot_dq.setZero();
+    dqddot_dqdot.setZero();
+    dqddot_dtau.setZero();
   }
   /// \return N, the number of segments.
   int num_segments() const { return N; }

@@ -1,0 +1,341 @@
+// Derivatives of the dynamics (algorithms/derivatives.hpp): rnea_derivatives and
+// aba_derivatives on random hybrid chains (lumped and distributed CC joints, revolute joints,
+// rigid links) against
+//   - central finite differences of rnea / forward_dynamics / aba in double (no AutoDiff;
+//     4th-order stencil);
+//   - an AutoDiff evaluation that shares neither the seeding nor the assembly: the chain cast
+//     to a dynamic-size AutoDiff scalar, all of (q, qdot[, tau]) active in one pass, through
+//     rnea and through forward_dynamics (its Cholesky differentiated, not M^-1 assembled);
+// on random states, at phi = 0 exactly and on both sides of the CC functions' series
+// switches (cc_functions.hpp); both chain kinds (a compile-time chain against the same
+// runtime chain); the size errors of a runtime chain; no heap allocation (static chain, and a
+// runtime chain after its first call), with the guard's positive control.
+#include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "softrne/algorithms/derivatives.hpp"
+#include "autodiff_reference.hpp"
+#include "support.hpp"
+
+namespace {
+
+using namespace softrne;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+using softrne_test::random_cc;
+using softrne_test::random_link;
+using softrne_test::random_rev;
+using softrne_test::random_vector;
+using softrne_test::rel_err;
+using CC = ConstantCurvatureJoint<double>;
+using CCDist = ConstantCurvatureJoint<double, DistributedInertia<>>;
+using Link = RigidLink<double>;
+using Rev = RevoluteJoint<double>;
+
+enum Kind { kCC, kLink, kRev, kCCDist };
+
+DynamicChain<double> make_chain(const std::vector<Kind>& kinds, std::mt19937& rng) {
+  DynamicChain<double> c;
+  for (Kind k : kinds) {
+    if (k == kCC) c.add(random_cc(rng));
+    if (k == kCCDist) c.add(random_cc<DistributedInertia<>>(rng));
+    if (k == kLink) c.add(random_link(rng));
+    if (k == kRev) c.add(random_rev(rng));
+  }
+  c.gravity = Eigen::Vector3d(softrne_test::uniform(rng, -1, 1), softrne_test::uniform(rng, -1, 1),
+                              softrne_test::uniform(rng, -1, 1))
+                  .normalized() *
+              9.81;
+  return c;
+}
+
+/// Random hybrid chains: every kind in each, shuffled (at most two revolute joints in a row,
+/// no bare revolute joint at the tip: M stays well conditioned).
+std::vector<DynamicChain<double>> random_chains(std::mt19937& rng) {
+  std::vector<DynamicChain<double>> out;
+  out.push_back(softrne_test::paper_arm());
+  for (int c = 0; c < 5; ++c) {
+    std::vector<Kind> k = {kCC, kCCDist, kRev, kLink, kCC, kLink};
+    std::shuffle(k.begin(), k.end(), rng);
+    for (std::size_t i = 1; i < k.size(); ++i)
+      if (k[i] == kRev && k[i - 1] == kRev) std::swap(k[i], k.back());
+    if (k.back() == kRev) std::swap(k.back(), k.front());
+    out.push_back(make_chain(k, rng));
+    if (c == 4) out.back().inertia_rate = InertiaRate::PaperFrozen;
+  }
+  return out;
+}
+
+/// q with every CC joint's (u, v) at bending angle phi in direction dir (others random).
+VectorXd bent(const DynamicChain<double>& chain, VectorXd q, double phi, double dir) {
+  for (int i = 0; i < chain.num_segments(); ++i)
+    if (std::visit([](const auto& s) { return std::decay_t<decltype(s)>::nq == 2; }, chain.segment(i))) {
+      q(chain.q_offset(i)) = phi * std::cos(dir);
+      q(chain.q_offset(i) + 1) = phi * std::sin(dir);
+    }
+  return q;
+}
+
+/// phi = 0 and the doubles next to each series switch (cc_functions.hpp; the lumped inertia
+/// also evaluates the functions at 4 phi^2, hence the halves).
+std::vector<double> special_angles() {
+  std::vector<double> a = {0.0};
+  const double sw = std::sqrt(detail::kCCSeriesSwitch), swd = std::sqrt(detail::kCCDiffSwitch);
+  for (double s : {sw, swd, sw / 2, swd / 2}) {
+    a.push_back(std::nextafter(s, 0.0));
+    a.push_back(std::nextafter(s, 10.0));
+  }
+  return a;
+}
+
+/// d f / d x(j) of a vector function by the 4th-order central difference, column j.
+template <class F>
+MatrixXd finite_difference(const VectorXd& x, double h, F&& f) {
+  const int n = static_cast<int>(x.size());
+  MatrixXd J;
+  for (int j = 0; j < n; ++j) {
+    auto at = [&](double t) {
+      VectorXd y = x;
+      y(j) += t;
+      return VectorXd(f(y));
+    };
+    const VectorXd d = (8.0 * (at(h) - at(-h)) - (at(2 * h) - at(-2 * h))) / (12.0 * h);
+    if (j == 0) J.resize(d.size(), n);
+    J.col(j) = d;
+  }
+  return J;
+}
+
+constexpr double kFdStep = 1e-3;
+// Worst relative errors met (printed): rnea 8e-12, aba 1.5e-9 (its FD divides rounding
+// errors of a solve by the step).
+constexpr double kFdTolRnea = 1e-9;
+constexpr double kFdTolAba = 1e-8;
+
+struct Worst {
+  double fd = 0, ad = 0;
+  void print(const char* what) const {
+    std::printf("[ info ] %s: worst relative error against finite differences %.1e, against "
+                "AutoDiff %.1e\n", what, fd, ad);
+  }
+};
+
+/// rnea_derivatives at (q, qd, qdd) against FD (kFdTolRnea) and, if built, one dynamic-size
+/// AutoDiff pass of rnea (1e-9); d tau/d qddot against M by FD in qddot.
+void check_rnea(const DynamicChain<double>& chain, const VectorXd& q, const VectorXd& qd,
+                const VectorXd& qdd, Worst& w) {
+  const int n = chain.num_coordinates();
+  auto data = chain.make_data();
+  rnea_derivatives(chain, data, q, qd, qdd);
+  const MatrixXd dq = data.dtau_dq, dqd = data.dtau_dqdot, M = data.mass_matrix;
+  const VectorXd tau = data.tau;
+  auto fd_data = chain.make_data();
+  EXPECT_LT(rel_err(tau, rnea(chain, fd_data, q, qd, qdd)), 1e-14);
+  const MatrixXd fq = finite_difference(q, kFdStep, [&](const VectorXd& x) { return rnea(chain, fd_data, x, qd, qdd); });
+  const MatrixXd fqd = finite_difference(qd, kFdStep, [&](const VectorXd& x) { return rnea(chain, fd_data, q, x, qdd); });
+  const MatrixXd fqdd = finite_difference(qdd, kFdStep, [&](const VectorXd& x) { return rnea(chain, fd_data, q, qd, x); });
+  const double e_fd = std::max({rel_err(dq, fq), rel_err(dqd, fqd), rel_err(M, fqdd)});
+  EXPECT_LT(e_fd, kFdTolRnea) << "q " << q.transpose() << "\nd tau/dq\n" << dq << "\nFD\n" << fq;
+  w.fd = std::max(w.fd, e_fd);
+#if SOFTRNE_TEST_AUTODIFF_REFERENCES
+  using AD = softrne_test::AD;
+  using VAD = Eigen::Matrix<AD, Eigen::Dynamic, 1>;
+  const auto chain_ad = chain.cast<AD>();
+  auto data_ad = chain_ad.make_data();
+  const VAD tau_ad = rnea(chain_ad, data_ad, softrne_test::make_active(q, 0, 2 * n),
+                          softrne_test::make_active(qd, n, 2 * n), VAD(qdd.cast<AD>()));
+  MatrixXd J(n, 2 * n);
+  for (int i = 0; i < n; ++i) J.row(i) = tau_ad(i).derivatives().transpose();
+  const double e_ad = std::max(rel_err(dq, J.leftCols(n)), rel_err(dqd, J.rightCols(n)));
+  EXPECT_LT(e_ad, 1e-9);
+  w.ad = std::max(w.ad, e_ad);
+#endif
+}
+
+/// aba_derivatives at (q, qd, tau) against FD of forward_dynamics and of aba (kFdTolAba) and, if
+/// built, one dynamic-size AutoDiff pass of forward_dynamics (1e-9); dqddot_dtau M = 1.
+void check_aba(const DynamicChain<double>& chain, const VectorXd& q, const VectorXd& qd,
+               const VectorXd& tau, Worst& w) {
+  const int n = chain.num_coordinates();
+  auto data = chain.make_data();
+  aba_derivatives(chain, data, q, qd, tau);
+  const MatrixXd dq = data.dqddot_dq, dqd = data.dqddot_dqdot, dtau = data.dqddot_dtau;
+  EXPECT_LT(rel_err(dtau * data.mass_matrix, MatrixXd::Identity(n, n)), 1e-12);
+  auto fd_data = chain.make_data();
+  const MatrixXd fq = finite_difference(q, kFdStep, [&](const VectorXd& x) { return forward_dynamics(chain, fd_data, x, qd, tau); });
+  const MatrixXd fqd = finite_difference(qd, kFdStep, [&](const VectorXd& x) { return aba(chain, fd_data, q, x, tau); });
+  const MatrixXd ft = finite_difference(tau, kFdStep, [&](const VectorXd& x) { return aba(chain, fd_data, q, qd, x); });
+  const double e_fd = std::max({rel_err(dq, fq), rel_err(dqd, fqd), rel_err(dtau, ft)});
+  EXPECT_LT(e_fd, kFdTolAba) << "q " << q.transpose() << "\nd qdd/dq\n" << dq << "\nFD\n" << fq;
+  w.fd = std::max(w.fd, e_fd);
+#if SOFTRNE_TEST_AUTODIFF_REFERENCES
+  using AD = softrne_test::AD;
+  using VAD = Eigen::Matrix<AD, Eigen::Dynamic, 1>;
+  const auto chain_ad = chain.cast<AD>();
+  auto data_ad = chain_ad.make_data();
+  const VAD qdd = forward_dynamics(chain_ad, data_ad, softrne_test::make_active(q, 0, 3 * n),
+                                   softrne_test::make_active(qd, n, 3 * n),
+                                   softrne_test::make_active(tau, 2 * n, 3 * n));
+  MatrixXd J(n, 3 * n);
+  for (int i = 0; i < n; ++i) J.row(i) = qdd(i).derivatives().transpose();
+  const double e_ad = std::max(
+      {rel_err(dq, J.leftCols(n)), rel_err(dqd, J.middleCols(n, n)), rel_err(dtau, J.rightCols(n))});
+  EXPECT_LT(e_ad, 1e-9);
+  w.ad = std::max(w.ad, e_ad);
+#endif
+}
+
+/// check(chain, q, qd, qdd_or_tau, worst) on 4 random states of each random chain.
+template <class Check>
+void on_random_states(unsigned seed, const char* what, Check check) {
+  std::mt19937 rng(seed);
+  Worst w;
+  for (const auto& chain : random_chains(rng)) {
+    const int n = chain.num_coordinates();
+    for (int s = 0; s < 4; ++s)
+      check(chain, random_vector(rng, n, 1.5), random_vector(rng, n, 2.0), random_vector(rng, n, 5.0), w);
+  }
+  w.print(what);
+}
+
+/// check(...) with every CC joint at phi = 0 or next to a series switch, in two directions,
+/// and at rest in the straight configuration (qdot = 0, phi = 0 exactly).
+template <class Check>
+void on_special_states(unsigned seed, const char* what, Check check) {
+  std::mt19937 rng(seed);
+  Worst w;
+  for (const auto& chain : random_chains(rng)) {
+    const int n = chain.num_coordinates();
+    for (double phi : special_angles())
+      for (double dir : {0.0, 0.7}) {
+        const VectorXd q = bent(chain, random_vector(rng, n, 1.0), phi, dir);
+        check(chain, q, random_vector(rng, n, 2.0), random_vector(rng, n, 5.0), w);
+      }
+    check(chain, bent(chain, VectorXd::Zero(n), 0.0, 0.0), VectorXd::Zero(n), random_vector(rng, n, 5.0), w);
+  }
+  w.print(what);
+}
+
+TEST(RneaDerivatives, RandomHybridChainsAndStates) {
+  on_random_states(21, "rnea_derivatives, random states", check_rnea);
+}
+
+TEST(RneaDerivatives, AtZeroBendingAndAtTheSeriesSwitches) {
+  on_special_states(22, "rnea_derivatives, phi = 0 and series switches", check_rnea);
+}
+
+TEST(AbaDerivatives, RandomHybridChainsAndStates) {
+  on_random_states(23, "aba_derivatives, random states", check_aba);
+}
+
+TEST(AbaDerivatives, AtZeroBendingAndAtTheSeriesSwitches) {
+  on_special_states(24, "aba_derivatives, phi = 0 and series switches", check_aba);
+}
+
+// ---------------------------------------------------------------------------------------
+// Both chain kinds, errors, allocation
+
+using Static = Chain<CC, Link, Rev, CCDist, Link, Rev, CC>;
+
+Static make_static(std::mt19937& rng) {
+  Static s(random_cc(rng), random_link(rng), random_rev(rng), random_cc<DistributedInertia<>>(rng),
+           random_link(rng), random_rev(rng), random_cc(rng));
+  s.gravity << 0.0, 0.0, 9.81;
+  return s;
+}
+
+DynamicChain<double> to_dynamic(const Static& s) {
+  DynamicChain<double> d;
+  std::apply([&](const auto&... seg) { (d.add(seg), ...); }, s.segments);
+  d.gravity = s.gravity;
+  return d;
+}
+
+TEST(Derivatives, StaticChainEqualsRuntimeChain) {
+  std::mt19937 rng(25);
+  const Static s = make_static(rng);
+  const DynamicChain<double> d = to_dynamic(s);
+  auto ds = s.make_data();
+  auto dd = d.make_data();
+  for (int k = 0; k < 5; ++k) {
+    const Static::VectorQ q = random_vector(rng, Static::nq, 1.5), qd = random_vector(rng, Static::nq, 2.0),
+                          a = random_vector(rng, Static::nq, 5.0);
+    rnea_derivatives(s, ds, q, qd, a);
+    rnea_derivatives(d, dd, VectorXd(q), VectorXd(qd), VectorXd(a));
+    EXPECT_LT(rel_err(ds.dtau_dq, dd.dtau_dq), 1e-13);
+    EXPECT_LT(rel_err(ds.dtau_dqdot, dd.dtau_dqdot), 1e-13);
+    EXPECT_LT(rel_err(ds.mass_matrix, dd.mass_matrix), 1e-13);
+    aba_derivatives(s, ds, q, qd, a);
+    aba_derivatives(d, dd, VectorXd(q), VectorXd(qd), VectorXd(a));
+    EXPECT_LT(rel_err(ds.dqddot_dq, dd.dqddot_dq), 1e-12);
+    EXPECT_LT(rel_err(ds.dqddot_dqdot, dd.dqddot_dqdot), 1e-12);
+    EXPECT_LT(rel_err(ds.dqddot_dtau, dd.dqddot_dtau), 1e-12);
+  }
+  // The chain's constants are read at every call, not when the workspace was made.
+  DynamicChain<double> heavier = d;
+  std::get<CC>(heavier.segment(0)).mass *= 2;
+  auto fresh = heavier.make_data();
+  const VectorXd q = VectorXd::Constant(Static::nq, 0.3), qd = VectorXd::Constant(Static::nq, 0.5);
+  rnea_derivatives(heavier, dd, q, qd, q);
+  rnea_derivatives(heavier, fresh, q, qd, q);
+  EXPECT_EQ(dd.dtau_dq, fresh.dtau_dq);
+  EXPECT_EQ(dd.dtau_dqdot, fresh.dtau_dqdot);
+}
+
+TEST(Derivatives, RuntimeChainSizeErrors) {
+  const auto arm = softrne_test::paper_arm();
+  auto data = arm.make_data();
+  const VectorXd ok = VectorXd::Zero(6), bad = VectorXd::Zero(3);
+  try {
+    rnea_derivatives(arm, data, bad, ok, ok);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "softrne::rnea_derivatives: q has 3 entries; the chain has 6 coordinates");
+  }
+  EXPECT_THROW(rnea_derivatives(arm, data, ok, ok, bad), std::invalid_argument);
+  EXPECT_THROW(aba_derivatives(arm, data, ok, bad, ok), std::invalid_argument);
+  try {
+    aba_derivatives(arm, data, ok, ok, bad);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "softrne::aba_derivatives: tau has 3 entries; the chain has 6 coordinates");
+  }
+  auto other = softrne_test::paper_arm();
+  other.add(Link{});
+  auto other_data = other.make_data();
+  EXPECT_THROW(rnea_derivatives(arm, other_data, ok, ok, ok), std::invalid_argument);
+}
+
+TEST(Derivatives, NoHeapAllocation) {
+  std::mt19937 rng(26);
+  const Static s = make_static(rng);
+  auto ds = s.make_data();
+  const DynamicChain<double> d = to_dynamic(s);
+  auto dd = d.make_data();
+  const Static::VectorQ q = random_vector(rng, Static::nq, 1.0), qd = random_vector(rng, Static::nq, 2.0),
+                        a = random_vector(rng, Static::nq, 5.0);
+  const VectorXd qx = q, qdx = qd, ax = a;
+  rnea_derivatives(d, dd, qx, qdx, ax);  // a runtime chain sizes its workspace once
+  aba_derivatives(d, dd, qx, qdx, ax);
+  const long before = softrne_test::eigen_assert_failures;
+  Eigen::internal::set_is_malloc_allowed(false);
+  rnea_derivatives(s, ds, q, qd, a);
+  aba_derivatives(s, ds, q, qd, a);
+  rnea_derivatives(d, dd, qx, qdx, ax);
+  aba_derivatives(d, dd, qx, qdx, ax);
+  Eigen::internal::set_is_malloc_allowed(true);
+  EXPECT_EQ(softrne_test::eigen_assert_failures, before) << "heap allocation where forbidden";
+  EXPECT_TRUE(ds.dqddot_dq.allFinite() && dd.dqddot_dq.allFinite());
+  EXPECT_GT(ds.dtau_dq.cwiseAbs().maxCoeff(), 0.0);
+}
+
+SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
+
+}  // namespace
