@@ -13,6 +13,7 @@
 #include "softrne/config.hpp"
 #include "softrne/algorithms/rnea.hpp"
 #include "softrne/arm/arm_dynamics.hpp"
+#include "softrne/chain/derivative_workspace.hpp"
 
 namespace softrne::sim {
 
@@ -37,10 +38,13 @@ enum class JacobianMethod { inverse_dynamics, forward_dynamics };
 /// (ArmSystem reads the pressures at t - delay).
 class ArmJacobian {
  public:
-  /// Derivative directions per AutoDiff pass. 2 (one SSE register) measured fastest for the
-  /// 12-state bundled arm: 0.43M instructions per Jacobian against 0.67M with 4, 0.73M with 12.
-  static constexpr int kBlock = 2;
-  using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, kBlock, 1>>;  ///< kBlock directions
+  /// Derivative directions per AutoDiff pass: the core derivatives' block (kDerivativeBlock,
+  /// chain/derivative_workspace.hpp). 2 (one SSE register) measured fastest for the 12-state
+  /// bundled arm: 0.43M instructions per Jacobian against 0.67M with 4, 0.73M with 12.
+  static constexpr int kBlock = kDerivativeBlock;
+  /// The AutoDiff scalar, the one of rnea_derivatives (the chain's segments are instantiated
+  /// once for both).
+  using AD = DerivativeScalar<double>;
   using ADVector = Eigen::Matrix<AD, Eigen::Dynamic, 1>;  ///< a vector of AD scalars
 
   /// \brief The state equation of `desc`.
@@ -156,17 +160,9 @@ SOFTRNE_SIM_INLINE bool ArmJacobian::jacobians(const Eigen::Ref<const Eigen::Vec
 
 SOFTRNE_SIM_INLINE void ArmJacobian::seed(const Eigen::Ref<const Eigen::VectorXd>& x,
                                           const Eigen::Ref<const Eigen::VectorXd>& p, int start) {
-  const int n = num_states(), m = num_inputs();
-  for (int i = 0; i < n; ++i) {
-    x_ad_(i).value() = x(i);
-    x_ad_(i).derivatives().setZero();
-    if (i >= start && i < start + kBlock) x_ad_(i).derivatives()(i - start) = 1.0;
-  }
-  for (int i = 0; i < m; ++i) {
-    pin_ad_(i).value() = p(i);
-    pin_ad_(i).derivatives().setZero();
-    if (n + i >= start && n + i < start + kBlock) pin_ad_(i).derivatives()(n + i - start) = 1.0;
-  }
+  // The variables of a pass are [x, p]: x from index 0, p from index num_states().
+  detail::seed_block(x, 0, start, x_ad_);
+  detail::seed_block(p, num_states(), start, pin_ad_);
 }
 
 SOFTRNE_SIM_INLINE bool ArmJacobian::differentiate(const Eigen::Ref<const Eigen::VectorXd>& x,
