@@ -131,7 +131,6 @@ struct Worst {
 /// AutoDiff pass of rnea (1e-9); d tau/d qddot against M by FD in qddot.
 void check_rnea(const DynamicChain<double>& chain, const VectorXd& q, const VectorXd& qd,
                 const VectorXd& qdd, Worst& w) {
-  const int n = chain.num_coordinates();
   auto data = chain.make_data();
   rnea_derivatives(chain, data, q, qd, qdd);
   const MatrixXd dq = data.dtau_dq, dqd = data.dtau_dqdot, M = data.mass_matrix;
@@ -147,6 +146,7 @@ void check_rnea(const DynamicChain<double>& chain, const VectorXd& q, const Vect
 #if SOFTRNE_TEST_AUTODIFF_REFERENCES
   using AD = softrne_test::AD;
   using VAD = Eigen::Matrix<AD, Eigen::Dynamic, 1>;
+  const int n = chain.num_coordinates();
   const auto chain_ad = chain.cast<AD>();
   auto data_ad = chain_ad.make_data();
   const VAD tau_ad = rnea(chain_ad, data_ad, softrne_test::make_active(q, 0, 2 * n),

@@ -11,6 +11,7 @@
 
 #include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/fit/loop.hpp"
+#include "softrne/io/recordings.hpp"
 #include "synthetic_arm.hpp"
 
 namespace {
@@ -88,12 +89,42 @@ TEST(ResidualAnalysis, NoiseIsAtTheFloorAndASignalAboveIt) {
 }
 
 TEST(LoopFolds, PartitionTheSamplesIntoAlternatingBlocks) {
-  const auto folds = fit::detail::make_folds(1000, 4);
+  io::Dataset one;
+  one.t = Eigen::VectorXd::LinSpaced(1000, 0.0, 9.99);
+  const auto folds = fit::detail::make_folds(one, 4);
   ASSERT_EQ(folds.size(), 2u);
   for (std::size_t i = 0; i < 1000; ++i) {
     EXPECT_NE(folds[0].held_rows[i], folds[1].held_rows[i]) << i;  // each sample held out once
     EXPECT_NE(folds[0].held_rows[i], folds[0].fit_rows[i]) << i;
     EXPECT_EQ(folds[0].held_rows[i], (i / 250) % 2 == 0) << i;
+  }
+}
+
+TEST(LoopFolds, HoldOutWholeRecordingsBalancedByLength) {
+  // Recordings of 500, 100, 300, 200 rows: the longest first to the fold holding out fewer
+  // rows: 500 -> fold 0, 300 -> fold 1, 200 -> fold 1, 100 -> fold 0 (600 / 500 rows).
+  std::vector<io::Dataset> parts;
+  for (int n : {500, 100, 300, 200}) {
+    io::Dataset p;
+    p.t = Eigen::VectorXd::LinSpaced(n, 0.0, 0.01 * (n - 1));
+    p.pressures = Eigen::MatrixXd::Zero(n, 2);
+    p.angles = Eigen::MatrixXd::Zero(n, 1);
+    p.has_angles = true;
+    p.source = "r" + std::to_string(n) + ".csv";
+    parts.push_back(p);
+  }
+  const io::Dataset data = io::stack_recordings(parts);
+  ASSERT_EQ(data.recordings.size(), 4u);
+  const auto folds = fit::detail::make_folds(data, 4);
+  const int expected_fold[] = {0, 0, 1, 1};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const auto& r = data.recordings[k];
+    for (Eigen::Index i = r.first_row; i < r.first_row + r.rows; ++i) {
+      const auto row = static_cast<std::size_t>(i);
+      EXPECT_EQ(folds[0].held_rows[row], expected_fold[k] == 0) << r.source << " row " << i;
+      EXPECT_EQ(folds[1].held_rows[row], expected_fold[k] == 1) << r.source << " row " << i;
+      EXPECT_NE(folds[0].fit_rows[row], folds[0].held_rows[row]);
+    }
   }
 }
 
@@ -134,7 +165,7 @@ TEST(LoopScreen, PredictsTheExactGainOfAnOffsetAndNoneForAnAbsentEffect) {
   ArmDescription truth = declared;
   add_effect(truth, off);
   const io::Dataset data = softrne_test::synthetic_dataset(truth, 4.0, 1.0, 7, 0.0, 0.0);
-  const auto folds = fit::detail::make_folds(data.t.size(), 4);
+  const auto folds = fit::detail::make_folds(data, 4);
   sim::ArmSimulationOptions so = fit::ArmFitOptions::default_simulation();
   so.cvode.rtol = 1e-9;
   so.cvode.atol = 1e-10;

@@ -161,19 +161,28 @@ class ArmDynamics {
   VectorS p_eff_, tau_;
 };
 
-/// \brief Initial state: at rest at the first measured configuration with the measurement
-/// model inverted (q0 = (y0 - offset) ./ gain), effect states from q0 and the first recorded
-/// pressures. An empty y0 means q0 = 0.
+/// \brief Initial state: at the first measured configuration with the measurement model
+/// inverted (q0 = (y0 - offset) ./ gain), at rest or at the measured rates (qdot0 = ydot0 ./
+/// gain), effect states from q0 and the first recorded pressures (their at-rest values there:
+/// a recording that starts in motion starts its effects' internal states as if at rest). An
+/// empty y0 means q0 = 0; an empty ydot0, at rest.
 /// \param[in] d The arm.
 /// \param[in] q0_measured The first measured angles y0 (nq), or empty.
 /// \param[in] p0 The first recorded pressures, Pa.
-/// \return The state [q0, 0, effect states].
+/// \param[in] qdot0_measured The measured angle rates at the first sample (nq), or empty.
+/// \return The state [q0, qdot0, effect states].
 SOFTRNE_SIM_INLINE Eigen::VectorXd initial_state(const ArmDescription& d, const Eigen::VectorXd& q0_measured,
-                                                 const Eigen::VectorXd& p0)
+                                                 const Eigen::VectorXd& p0,
+                                                 const Eigen::VectorXd& qdot0_measured = Eigen::VectorXd())
 #if SOFTRNE_SIM_BODIES
 {
   Eigen::VectorXd x = Eigen::VectorXd::Zero(d.num_states());
   if (q0_measured.size() == d.nq) x.head(d.nq) = d.coordinates_from_measured(q0_measured);
+  if (qdot0_measured.size() == d.nq) {
+    Eigen::VectorXd gain, offset;
+    d.measurement(gain, offset);
+    x.segment(d.nq, d.nq) = qdot0_measured.cwiseQuotient(gain);
+  }
   const Eigen::VectorXd q0 = x.head(d.nq);
   for (std::size_t k = 0; k < d.effects.size(); ++k) {
     auto xs = x.segment(2 * d.nq + d.effect_state_offsets[k], d.effect_state_size(k));

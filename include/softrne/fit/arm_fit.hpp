@@ -170,10 +170,12 @@ SOFTRNE_FIT_INLINE void apply(const std::vector<ParamSlot>& slots, const Eigen::
 
 }  // namespace detail
 
-/// \brief Simulates the arm on a data set (from rest at the first measured row), at
+/// \brief Simulates the arm on a data set, each of its recordings from its own first measured
+/// row (at rest, or at the recording's initial rates: io::estimate_initial_rates()), at
 /// `opt`'s tolerances or tighter where the model's effects need it (effect_max_atol: a
 /// smoothed Coulomb friction needs atol 1e-6), so that every fit, screen and held-out error
-/// sees such an effect resolved whatever the caller's default.
+/// sees such an effect resolved whatever the caller's default. The recordings' simulations
+/// are stacked as their rows are; the first that fails ends it (its message names the file).
 /// \param[in] d The arm.
 /// \param[in] data The data set (times, recorded pressures, measured angles).
 /// \param[in] opt The integrator settings.
@@ -182,11 +184,48 @@ SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d, 
                                                        const sim::ArmSimulationOptions& opt)
 #if SOFTRNE_FIT_BODIES
 {
-  const Eigen::VectorXd q0 =
-      data.has_angles ? Eigen::VectorXd(data.angles.row(0).transpose()) : Eigen::VectorXd::Zero(d.nq);
   sim::ArmSimulationOptions o = opt;
   for (const AnyEffect& e : d.effects) o.cvode.atol = std::min(o.cvode.atol, effect_max_atol(e));
-  return sim::simulate_arm(d, data.t, data.pressures, q0, o);
+  auto first_angles = [&](Eigen::Index row) {
+    return data.has_angles ? Eigen::VectorXd(data.angles.row(row).transpose()) : Eigen::VectorXd::Zero(d.nq);
+  };
+  if (data.recordings.empty()) return sim::simulate_arm(d, data.t, data.pressures, first_angles(0), o);
+  sim::ArmSimulation out;
+  const Eigen::Index N = data.t.size();
+  out.angles.resize(N, d.nq);
+  out.states.resize(N, d.num_states());
+  out.result.ok = true;
+  for (const io::Dataset::Recording& r : data.recordings) {
+    // Each recording on its own times (its time shift taken off): a pressure signal, its
+    // breakpoints and any input delay start at the recording's own first sample.
+    const Eigen::VectorXd t = data.t.segment(r.first_row, r.rows).array() - r.time_shift;
+    sim::ArmSimulation s = sim::simulate_arm(d, t, data.pressures.middleRows(r.first_row, r.rows),
+                                             first_angles(r.first_row), r.initial_rates, o);
+    sim::SimulationStats& st = out.result.stats;
+    const sim::SimulationStats& rs = s.result.stats;
+    st.steps += rs.steps;
+    st.rhs_evals += rs.rhs_evals;
+    st.jac_evals += rs.jac_evals;
+    st.rhs_evals_for_jacobian_fd += rs.rhs_evals_for_jacobian_fd;
+    st.error_test_failures += rs.error_test_failures;
+    st.nonlinear_convergence_failures += rs.nonlinear_convergence_failures;
+    st.restarts += rs.restarts + 1;  // each recording starts afresh
+    st.wall_seconds += rs.wall_seconds;
+    const Eigen::Index done = s.states.rows();
+    out.states.middleRows(r.first_row, done) = s.states;
+    out.angles.middleRows(r.first_row, done) = s.angles;
+    out.result.t_reached = r.first_row + done > 0 ? data.t(r.first_row + done - 1) : data.t(0);
+    if (!s.ok()) {
+      out.result.ok = false;
+      out.result.message = r.source + ": " + s.result.message;
+      const Eigen::Index rows = r.first_row + done;
+      out.states.conservativeResize(rows, Eigen::NoChange);
+      out.angles.conservativeResize(rows, Eigen::NoChange);
+      break;
+    }
+  }
+  out.result.x = out.states;
+  return out;
 }
 #else
 ;

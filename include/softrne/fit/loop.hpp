@@ -7,7 +7,8 @@
 /// Method (docs/closing-the-loop.md):
 ///  1. Baseline: stiffness and damping fitted by simulation error on all training data.
 ///  2. Folds: the training record is cut into `cv_blocks` contiguous time blocks; fold f is
-///     fitted on the blocks b with b % 2 != f and measured on the others. Each fold has its own
+///     fitted on the blocks b with b % 2 != f and measured on the others (several training
+///     recordings: whole recordings are held out, detail::make_folds). Each fold has its own
 ///     base model, fitted from the DECLARED model on the fold's training blocks alone (global
 ///     stage included), so nothing a fold's decision uses has seen its held-out blocks.
 ///  3. Screen (candidates.hpp): every effect, in every scope it allows, gets a linearised
@@ -216,16 +217,40 @@ inline void adopt(Fold& f, const FoldTrial& t) {
   f.held_rms = t.held_rms;
 }
 
-inline std::vector<Fold> make_folds(Eigen::Index N, int blocks) {
+/// The two folds' masks. One recording: `blocks` contiguous time blocks, fold f holding out
+/// the blocks b with b % 2 == f. Several: whole recordings, so that no fold is judged on the
+/// rest of a recording it was fitted on; each recording (the longest first) is held out by
+/// the fold that holds out fewer rows so far, which balances the folds whatever the lengths
+/// (alternating by file order could hold out 1 short log in one fold and 5 long ones in the
+/// other).
+inline std::vector<Fold> make_folds(const io::Dataset& train, int blocks) {
+  const Eigen::Index N = train.t.size();
   std::vector<Fold> folds(2);
-  blocks = std::max(2, blocks);
+  std::vector<int> held_by(static_cast<std::size_t>(N));
+  if (train.recordings.size() >= 2) {
+    std::vector<std::size_t> order(train.recordings.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return train.recordings[a].rows > train.recordings[b].rows;
+    });
+    Eigen::Index held[2] = {0, 0};
+    for (std::size_t k : order) {
+      const io::Dataset::Recording& r = train.recordings[k];
+      const int f = held[1] < held[0] ? 1 : 0;
+      held[f] += r.rows;
+      for (Eigen::Index i = r.first_row; i < r.first_row + r.rows; ++i) held_by[static_cast<std::size_t>(i)] = f;
+    }
+  } else {
+    blocks = std::max(2, blocks);
+    for (Eigen::Index i = 0; i < N; ++i) held_by[static_cast<std::size_t>(i)] = static_cast<int>((i * blocks) / N) % 2;
+  }
   for (int f = 0; f < 2; ++f) {
-    folds[static_cast<std::size_t>(f)].fit_rows.resize(static_cast<std::size_t>(N));
-    folds[static_cast<std::size_t>(f)].held_rows.resize(static_cast<std::size_t>(N));
-    for (Eigen::Index i = 0; i < N; ++i) {
-      const bool held = static_cast<int>((i * blocks) / N) % 2 == f;
-      folds[static_cast<std::size_t>(f)].held_rows[static_cast<std::size_t>(i)] = held;
-      folds[static_cast<std::size_t>(f)].fit_rows[static_cast<std::size_t>(i)] = !held;
+    Fold& fold = folds[static_cast<std::size_t>(f)];
+    fold.fit_rows.resize(static_cast<std::size_t>(N));
+    fold.held_rows.resize(static_cast<std::size_t>(N));
+    for (std::size_t i = 0; i < static_cast<std::size_t>(N); ++i) {
+      fold.held_rows[i] = held_by[i] == f;
+      fold.fit_rows[i] = held_by[i] != f;
     }
   }
   return folds;
@@ -358,7 +383,6 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   LoopResult out;
   const int threads = std::max(1, opt.fit.optimiser.threads);
   const sim::ArmSimulationOptions& sim_opt = opt.fit.simulation;
-  const Eigen::Index N = train.t.size();
 
   out.noise_sigma = signals::estimate_noise_sigma(train.angles);
   out.noise_floor = noise_floor_median(std::sqrt(out.noise_sigma.squaredNorm() /
@@ -373,7 +397,7 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   }
 
   // Fold base models, each fitted from the declared model on its own training blocks.
-  std::vector<detail::Fold> folds = detail::make_folds(N, opt.cv_blocks);
+  std::vector<detail::Fold> folds = detail::make_folds(train, opt.cv_blocks);
   for (std::size_t f = 0; f < folds.size(); ++f) {
     log("fold " + std::to_string(f + 1) + ": base fit on its training blocks");
     ArmFitOptions o = opt.fit;

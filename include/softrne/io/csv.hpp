@@ -30,6 +30,22 @@ struct Dataset {
   std::vector<std::string> pressure_names;  ///< the P pressure column names, in order
   std::vector<std::string> angle_names;     ///< the nq coordinate names (even when absent)
   std::string source;  ///< the file, for messages
+
+  /// \brief One recording of a data set that stacks several (io::stack_recordings()).
+  struct Recording {
+    Eigen::Index first_row = 0;  ///< its first row in t, pressures and angles
+    Eigen::Index rows = 0;       ///< its number of rows
+    /// Added to the recording's own times so that the stacked t increases strictly: t of
+    /// its first row minus its file's first time.
+    double time_shift = 0;
+    std::string source;  ///< its file, for messages
+    /// Measured angle rates at its first sample (rad/s, size nq; estimate_initial_rates()):
+    /// the simulation starts with them. Empty: at rest, as the paper's experiments start.
+    Eigen::VectorXd initial_rates;
+  };
+  /// The recordings, in row order, each simulated from its own first sample. Empty: the data
+  /// set is one recording that starts at rest (every data set read from one file).
+  std::vector<Recording> recordings;
 };
 
 namespace detail {

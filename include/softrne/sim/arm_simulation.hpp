@@ -273,7 +273,8 @@ inline Eigen::MatrixXd measured_angles(const ArmDescription& desc, const Eigen::
 }  // namespace detail
 
 /// \brief Simulates the arm on the time grid t with the recorded pressures (N x num_inputs),
-/// from rest at the measured configuration q0 (size nq; zero if empty).
+/// from the measured configuration q0 (size nq; zero if empty) at the measured angle rates
+/// qdot0 (size nq; at rest if empty: the overload without it).
 ///
 /// The state equation is eq. 23 with the effects (ArmDynamics), integrated by CVODE's BDF
 /// method with the exact AutoDiff Jacobian; the integration restarts at pressure steps
@@ -282,12 +283,13 @@ inline Eigen::MatrixXd measured_angles(const ArmDescription& desc, const Eigen::
 /// \param[in] t The N output (and input sample) times, s.
 /// \param[in] pressures N x num_inputs recorded pressures, Pa.
 /// \param[in] q0 The measured angles at t(0) (size nq), or empty for zero.
+/// \param[in] qdot0 The measured angle rates at t(0) (size nq, rad/s), or empty for rest.
 /// \param[in] opt Integrator, interpolation and Jacobian settings.
 /// \return The measured-space angles and states on the grid; result.ok false with a one-line
 ///   result.message if the integration failed (no exception for a computation that fails).
 SOFTRNE_SIM_INLINE ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::VectorXd& t,
                                               const Eigen::MatrixXd& pressures, const Eigen::VectorXd& q0,
-                                              const ArmSimulationOptions& opt = {})
+                                              const Eigen::VectorXd& qdot0, const ArmSimulationOptions& opt)
 #if SOFTRNE_SIM_BODIES
 {
   using PI = ArmSimulationOptions::PressureInterpolation;
@@ -300,7 +302,7 @@ SOFTRNE_SIM_INLINE ArmSimulation simulate_arm(const ArmDescription& desc, const 
   ArmSystem sys(desc, t, p, opt.interpolation);
   sys.set_progress(&opt.progress);
   sys.set_jacobian_method(opt.jacobian_method);
-  const Eigen::VectorXd x0 = initial_state(desc, q0, p.row(0).transpose());
+  const Eigen::VectorXd x0 = initial_state(desc, q0, p.row(0).transpose(), qdot0);
   CvodeOptions copt = opt.cvode;
   copt.use_analytic_jacobian = opt.autodiff_jacobian;
   std::vector<double> bp;
@@ -319,5 +321,12 @@ SOFTRNE_SIM_INLINE ArmSimulation simulate_arm(const ArmDescription& desc, const 
 #else
 ;
 #endif
+
+/// \brief simulate_arm() from rest at the measured configuration q0 (size nq; zero if empty).
+inline ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::VectorXd& t,
+                                  const Eigen::MatrixXd& pressures, const Eigen::VectorXd& q0,
+                                  const ArmSimulationOptions& opt = {}) {
+  return simulate_arm(desc, t, pressures, q0, Eigen::VectorXd(), opt);
+}
 
 }  // namespace softrne::sim
