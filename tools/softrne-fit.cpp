@@ -4,6 +4,7 @@
 
 #include "common/cli.hpp"
 #include "common/outputs.hpp"
+#include "common/recordings.hpp"
 #include "common/report.hpp"
 #include "softrne/fit/arm_fit.hpp"
 #include "softrne/io/csv.hpp"
@@ -13,25 +14,27 @@ int main(int argc, char** argv) {
   using namespace softrne;
   return cli::run("softrne-fit", [&] {
     cli::App app(
-        "softrne-fit", "--robot R.json --data train.csv --out fitted.json [--test test.csv]",
+        "softrne-fit", "--robot R.json --data train.csv [--data ...] --out fitted.json [--test test.csv ...]",
         "Fits the per-axis stiffness and damping of every joint (and the parameters of the "
         "robot's effects) to measured angles by simulation error: the model is simulated from "
-        "the first sample with the recorded pressures. Prints the fitted values with their "
-        "standard errors and the error tables (paper Tables I-II) before and after.");
-    std::string robot_path, data_path, out_path, test_path, report_path;
+        "the first sample with the recorded pressures (each recording from its own first "
+        "sample). Prints the fitted values with their standard errors and the error tables "
+        "(paper Tables I-II) before and after.");
+    std::string robot_path, out_path, report_path, initial_motion = "rest";
+    std::vector<std::string> data_paths, test_paths;
     fit::ArmFitOptions opt;
     app.add_option("--robot", robot_path,
                    "robot description (softrne-robot/1); its values are the starting guesses")
         ->type_name("R.json")
         ->required();
-    app.add_option("--data", data_path, "pressures and measured angles")
-        ->type_name("train.csv")
+    cli::add_recordings_option(app, "--data", data_paths, "pressures and measured angles", "train.csv")
         ->required();
     app.add_option("--out", out_path, "where to write the fitted robot")
         ->type_name("fitted.json")
         ->required();
-    app.add_option("--test", test_path, "a held-out data set: only measured, never fitted")
-        ->type_name("test.csv");
+    cli::add_recordings_option(app, "--test", test_paths, "a held-out data set: only measured, never fitted",
+                               "test.csv");
+    cli::add_initial_motion_option(app, initial_motion);
     app.add_option("--report", report_path,
                    "also write the fit report here (softrne-fit-report/1: parameters, standard "
                    "errors, error statistics, fitted robot)")
@@ -45,14 +48,15 @@ int main(int argc, char** argv) {
     bool quiet = false;
     app.add_flag("--quiet", quiet, "no progress line");
     if (!app.parse_command_line(argc, argv)) return cli::kExitOk;
-    cli::check_outputs_are_not_inputs(
-        {{"--robot", robot_path}, {"--data", data_path}, {"--test", test_path}},
-        {{"--out", out_path}, {"--report", report_path}});
+    std::vector<cli::FileOption> inputs{{"--robot", robot_path}};
+    cli::append_file_options(inputs, "--data", data_paths);
+    cli::append_file_options(inputs, "--test", test_paths);
+    cli::check_outputs_are_not_inputs(inputs, {{"--out", out_path}, {"--report", report_path}});
     const io::RobotSpec spec = io::read_robot_json(robot_path);
-    const io::Dataset train = io::read_dataset(data_path, spec, true);
+    const io::Dataset train = cli::read_recordings(data_paths, spec, true, initial_motion, "--data");
     io::Dataset test;
-    const bool has_test = !test_path.empty();
-    if (has_test) test = io::read_dataset(test_path, spec, true);
+    const bool has_test = !test_paths.empty();
+    if (has_test) test = cli::read_recordings(test_paths, spec, true, initial_motion, "--test");
     ArmDescription desc;
     try {
       desc = build_arm(spec);
@@ -72,8 +76,12 @@ int main(int argc, char** argv) {
     if (!quiet) std::fprintf(stderr, "\n");
     const fit::ArmFitResult& r = run.result;
     io::write_robot_json(to_robot_spec(r.fitted), out_path);
-    if (!report_path.empty())
-      io::detail::write_text_file(report_path, cli::fit_report_json(run).dump(2) + "\n");
+    if (!report_path.empty()) {
+      nlohmann::ordered_json report = cli::fit_report_json(run);
+      if (!train.recordings.empty() || !test.recordings.empty())
+        report["recordings"] = {{"train", cli::recordings_json(train)}, {"test", cli::recordings_json(test)}};
+      io::detail::write_text_file(report_path, report.dump(2) + "\n");
+    }
     std::printf("fitted %d parameters in %.1f s (%d simulations)\n", r.parameters.size(), r.wall_seconds, r.simulations);
     std::printf("%s", cli::parameter_table(r).c_str());
     if (!r.fit.identifiability_report.empty()) std::printf("identifiability:\n%s\n", r.fit.identifiability_report.c_str());

@@ -9,6 +9,7 @@
 
 #include "common/cli.hpp"
 #include "common/outputs.hpp"
+#include "common/recordings.hpp"
 #include "common/report.hpp"
 #include "softrne/fit/loop.hpp"
 #include "softrne/io/csv.hpp"
@@ -53,23 +54,26 @@ int main(int argc, char** argv) {
   return cli::run("softrne-loop", [&] {
     cli::App app(
         "softrne-loop",
-        "--robot R.json --train train.csv --test test.csv --out report.json [--plots DIR]",
+        "--robot R.json --train train.csv [--train ...] --test test.csv [--test ...] --out report.json [--plots DIR]",
         "Fits the declared model, screens every effect in every scope by its predicted held-out "
         "simulation error, refits the best in cross-validation folds of the training data, adds "
         "those that lower the held-out error in every fold, refits, and reports the error before "
         "and after, the sensor noise floor and what stays unexplained "
-        "(docs/closing-the-loop.md). The test data only measures.");
-    std::string robot_path, train_path, test_path, out_path, plots_dir;
+        "(docs/closing-the-loop.md). The test data only measures. With several training "
+        "recordings the folds hold out whole recordings.");
+    std::string robot_path, out_path, plots_dir, initial_motion = "rest";
+    std::vector<std::string> train_paths, test_paths;
     fit::LoopOptions opt;
     app.add_option("--robot", robot_path, "robot description (softrne-robot/1)")
         ->type_name("R.json")
         ->required();
-    app.add_option("--train", train_path, "training data (pressures and measured angles)")
-        ->type_name("train.csv")
+    cli::add_recordings_option(app, "--train", train_paths, "training data (pressures and measured angles)",
+                               "train.csv")
         ->required();
-    app.add_option("--test", test_path, "test data: measured only, never used to select")
-        ->type_name("test.csv")
+    cli::add_recordings_option(app, "--test", test_paths, "test data: measured only, never used to select",
+                               "test.csv")
         ->required();
+    cli::add_initial_motion_option(app, initial_motion);
     app.add_option("--out", out_path, "the report (softrne-loop-report/2)")
         ->type_name("report.json")
         ->required();
@@ -86,12 +90,13 @@ int main(int argc, char** argv) {
     bool quiet = false;
     app.add_flag("--quiet", quiet, "no progress lines");
     if (!app.parse_command_line(argc, argv)) return cli::kExitOk;
-    cli::check_outputs_are_not_inputs(
-        {{"--robot", robot_path}, {"--train", train_path}, {"--test", test_path}},
-        {{"--out", out_path}});
+    std::vector<cli::FileOption> inputs{{"--robot", robot_path}};
+    cli::append_file_options(inputs, "--train", train_paths);
+    cli::append_file_options(inputs, "--test", test_paths);
+    cli::check_outputs_are_not_inputs(inputs, {{"--out", out_path}});
     const io::RobotSpec spec = io::read_robot_json(robot_path);
-    const io::Dataset train = io::read_dataset(train_path, spec, true);
-    const io::Dataset test = io::read_dataset(test_path, spec, true);
+    const io::Dataset train = cli::read_recordings(train_paths, spec, true, initial_motion, "--train");
+    const io::Dataset test = cli::read_recordings(test_paths, spec, true, initial_motion, "--test");
     ArmDescription desc;
     try {
       desc = build_arm(spec);
@@ -110,7 +115,27 @@ int main(int argc, char** argv) {
     }
     cli::throw_if_interrupted("the closed loop");
     if (!plots_dir.empty()) write_plot_data(plots_dir, r, train, test, opt);
-    io::detail::write_text_file(out_path, cli::loop_report_json(r, true, opt).dump(2) + "\n");
+    nlohmann::ordered_json report = cli::loop_report_json(r, true, opt);
+    // Per held-out recording, the median error before and after (several test recordings).
+    std::vector<std::pair<std::string, double>> test_before, test_after;
+    if (test.recordings.size() >= 2) {
+      const auto before = fit::simulate_dataset(r.baseline.fitted, test, opt.fit.simulation);
+      const auto after = fit::simulate_dataset(r.final_fit.fitted, test, opt.fit.simulation);
+      const auto& names = r.final_fit.fitted.coordinate_names;
+      if (before.ok()) test_before = cli::recording_medians(test, before.angles, names);
+      if (after.ok()) test_after = cli::recording_medians(test, after.angles, names);
+    }
+    if (!train.recordings.empty() || !test.recordings.empty()) {
+      nlohmann::ordered_json per = nlohmann::ordered_json::array();
+      for (std::size_t k = 0; k < test_before.size() && k < test_after.size(); ++k)
+        per.push_back({{"source", test_before[k].first},
+                       {"baseline_median", test_before[k].second},
+                       {"final_median", test_after[k].second}});
+      report["recordings"] = {{"train", cli::recordings_json(train)},
+                              {"test", cli::recordings_json(test)},
+                              {"test_medians", per}};
+    }
+    io::detail::write_text_file(out_path, report.dump(2) + "\n");
     std::printf("closed loop in %.1f s (%d simulations)\n", r.wall_seconds, r.simulations);
     std::printf("sensor noise estimated from the training angles: floor (median |error| of noise alone) %.4f rad\n",
                 r.noise_floor);
@@ -149,6 +174,9 @@ int main(int argc, char** argv) {
     std::printf("%s", format_error_table(r.final_train, "train, final").c_str());
     std::printf("%s", format_error_table(r.baseline_test, "test, baseline").c_str());
     std::printf("%s", format_error_table(r.final_test, "test, final").c_str());
+    for (std::size_t k = 0; k < test_before.size() && k < test_after.size(); ++k)
+      std::printf("  %s: median error %.4f -> %.4f rad\n", test_before[k].first.c_str(), test_before[k].second,
+                  test_after[k].second);
     std::printf("test median error: %.4f -> %.4f rad\nwrote %s\n", r.baseline_test.total.median,
                 r.final_test.total.median, out_path.c_str());
     return cli::kExitOk;

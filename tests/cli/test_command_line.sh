@@ -104,6 +104,18 @@ fi
 usage "$fit" "--out is --data" "refusing to overwrite an input" --robot "$robot" --data "$train" --out "$train"
 usage "$loop" "--out is --test" "refusing to overwrite an input" --robot "$robot" --train "$train" --test "$test" \
   --out "$test"
+usage "$fit" "--out is the second --data" "refusing to overwrite an input" --robot "$robot" --data "$train" \
+  --data "$test" --out "$test"
+
+# ---- several recordings: one file per --data/--train/--test, each once ------------------------
+usage "$fit" "--data a b" "unexpected argument: '$test'" --robot "$robot" --data "$train" "$test" \
+  --out "$tmp/fitted.json"
+usage "$fit" "a file given twice" "--data: $train is given twice" --robot "$robot" --data "$train" \
+  --data "$train" --out "$tmp/fitted.json"
+usage "$loop" "a --test file given twice" "--test: $test is given twice" "${loop_ok[@]:0:4}" --test "$test" \
+  --test "$test" --out "$tmp/report.json"
+usage "$loop" "--initial-motion moving" "--initial-motion: moving not in {rest,estimated}" "${loop_ok[@]}" \
+  --initial-motion moving
 [[ -e $tmp/fitted.json || -e $tmp/report.json || -e $tmp/case ]] && fail "a refused command line wrote a file"
 
 finish
