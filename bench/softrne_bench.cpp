@@ -14,7 +14,8 @@
 //                                          [or absolute tolerance 1e-8]
 // with <algo> in rnea, gravity, bias, mass_matrix, forward_dynamics, aba, rnea_derivatives,
 // aba_derivatives (algorithms/derivatives.hpp) and <fn> in rnea,
-// gravity (computeGeneralizedGravity), bias (nonLinearEffects), crba, aba.
+// gravity (computeGeneralizedGravity), bias (nonLinearEffects), crba, aba,
+// rnea_derivatives (computeRNEADerivatives), aba_derivatives (computeABADerivatives).
 //
 // Every call goes through a non-inlined wrapper (as Pinocchio's benchmark/timings.cpp does)
 // and cycles through kStates random states prepared beforehand. After the runs, a summary
@@ -39,8 +40,10 @@
 #include "softrne/softrne.hpp"
 
 #ifdef SOFTRNE_BENCH_WITH_PINOCCHIO
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody.hpp>
 #endif
@@ -458,6 +461,20 @@ SOFTRNE_BENCH_NOINLINE const VectorXd& pin_aba(const pin::Model& m, pin::Data& d
   return pin::aba(m, d, q, v, tau, pin::Convention::LOCAL);
 }
 
+// (Pinocchio's derivative matrices are row-major: their data pointer is returned.)
+SOFTRNE_BENCH_NOINLINE const double* pin_rnea_derivatives(const pin::Model& m, pin::Data& d,
+                                                          const VectorXd& q, const VectorXd& v,
+                                                          const VectorXd& a) {
+  pin::computeRNEADerivatives(m, d, q, v, a);
+  return d.dtau_dq.data();
+}
+SOFTRNE_BENCH_NOINLINE const double* pin_aba_derivatives(const pin::Model& m, pin::Data& d,
+                                                         const VectorXd& q, const VectorXd& v,
+                                                         const VectorXd& tau) {
+  pin::computeABADerivatives(m, d, q, v, tau);
+  return d.ddq_dq.data();
+}
+
 void register_pinocchio(const std::string& prefix, std::shared_ptr<PinocchioFixture> f) {
   const int nq = f->model.nq;
   auto reg = [&](const char* fn, auto body) {
@@ -488,6 +505,13 @@ void register_pinocchio(const std::string& prefix, std::shared_ptr<PinocchioFixt
   reg("aba", [](Fix& x, unsigned k) {
     benchmark::DoNotOptimize(pin_aba(x.model, x.data, x.q[k], x.qd[k], x.tau[k]).data());
   });
+  // Against softrne's rnea_derivatives / aba_derivatives (analytical recursions in Pinocchio).
+  reg("rnea_derivatives", [](Fix& x, unsigned k) {
+    benchmark::DoNotOptimize(pin_rnea_derivatives(x.model, x.data, x.q[k], x.qd[k], x.qdd[k]));
+  });
+  reg("aba_derivatives", [](Fix& x, unsigned k) {
+    benchmark::DoNotOptimize(pin_aba_derivatives(x.model, x.data, x.q[k], x.qd[k], x.tau[k]));
+  });
 }
 
 /// Before timing anything: the Pinocchio models must give softrne's numbers.
@@ -507,6 +531,19 @@ bool pinocchio_agrees(ChainFixture<DynamicChain<double>>& s, PinocchioFixture& p
     const VectorXd qdd = forward_dynamics(s.chain, s.data, s.q[k], s.qd[k], s.tau[k]);
     pin::aba(p.model, p.data, p.q[k], p.qd[k], p.tau[k], pin::Convention::LOCAL);
     err = std::max(err, (qdd - p.data.ddq).cwiseAbs().maxCoeff());
+    // The derivatives, before their timings are compared.
+    rnea_derivatives(s.chain, s.data, s.q[k], s.qd[k], s.qdd[k]);
+    pin::computeRNEADerivatives(p.model, p.data, p.q[k], p.qd[k], p.qdd[k]);
+    err = std::max(err, (s.data.dtau_dq - p.data.dtau_dq).cwiseAbs().maxCoeff());
+    err = std::max(err, (s.data.dtau_dqdot - p.data.dtau_dv).cwiseAbs().maxCoeff());
+    aba_derivatives(s.chain, s.data, s.q[k], s.qd[k], s.tau[k]);
+    pin::computeABADerivatives(p.model, p.data, p.q[k], p.qd[k], p.tau[k]);
+    err = std::max(err, (s.data.dqddot_dq - p.data.ddq_dq).cwiseAbs().maxCoeff());
+    err = std::max(err, (s.data.dqddot_dqdot - p.data.ddq_dv).cwiseAbs().maxCoeff());
+    // M^-1: Pinocchio fills only the upper triangle of data.Minv.
+    Eigen::MatrixXd dMinv = s.data.dqddot_dtau - p.data.Minv;
+    dMinv.triangularView<Eigen::StrictlyLower>().setZero();
+    err = std::max(err, dMinv.cwiseAbs().maxCoeff());
   }
   std::fprintf(stderr,
                "softrne-bench: check %-28s max |softrne - Pinocchio| / max(1, |tau|) = %.1e\n",
@@ -626,13 +663,22 @@ class SummaryReporter : public benchmark::ConsoleReporter {
                                                            {"bias", "bias"},
                                                            {"mass_matrix", "crba"},
                                                            {"forward_dynamics", "aba"},
-                                                           {"aba", "aba"}};
+                                                           {"aba", "aba"},
+                                                           {"rnea_derivatives", "rnea_derivatives"},
+                                                           {"aba_derivatives", "aba_derivatives"}};
       for (const char* impl : {"static", "dynamic"})
         for (const auto& [ours, theirs] : pairs)
           for (const char* pin_impl : {"pinocchio", "pinocchio_unaligned"})
             ratio(m + " softrne " + impl + " " + ours + " / " + pin_impl + " " + theirs,
                   m + "/" + impl + "/" + ours, m + "/" + pin_impl + "/" + theirs);
     }
+    // Pinocchio's own derivative / rnea ratio (the issue guessed "about 2-3x for rigid
+    // chains"; docs/performance.md, "Derivatives", has the measurement).
+    for (const char* model : {"rev6", "rev30"})
+      for (const char* pin_impl : {"pinocchio", "pinocchio_unaligned"})
+        ratio(std::string(model) + " " + pin_impl + ": rnea_derivatives / rnea",
+              std::string(model) + "/" + pin_impl + "/rnea_derivatives",
+              std::string(model) + "/" + pin_impl + "/rnea");
     // Scaling of the runtime CC chain: time per CC segment (each with its rigid link).
     for (const char* a : {"rnea", "mass_matrix", "aba"}) {
       double ref = 0;
