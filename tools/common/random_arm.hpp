@@ -72,6 +72,7 @@
 #include "softrne/algorithms/bias.hpp"
 #include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/arm/arm_dynamics.hpp"
+#include "softrne/arm/equilibrium.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_spec.hpp"
 #include "softrne/sim/arm_simulation.hpp"
@@ -288,45 +289,8 @@ inline ArmDescription build(const io::RobotSpec& s) {
   }
 }
 
-/// Static equilibrium at pressures p (qdot = 0, effect states from p): damped Newton on the
-/// accelerations, Jacobian by central differences.
-inline Vec equilibrium(const ArmDescription& d, const Vec& p, Vec q) {
-  ArmDynamics<double> f(d);
-  const int n = d.nq;
-  Vec x = initial_state(d, Vec(), p), xd(x.size());
-  auto acc = [&](const Vec& qq) {
-    x.head(n) = qq;
-    x.segment(n, n).setZero();
-    f.rhs(x, p, xd);
-    return Vec(xd.segment(n, n));
-  };
-  if (q.size() != n) q = Vec::Zero(n);
-  Vec r = acc(q);
-  for (int it = 0; it < 200 && r.lpNorm<Eigen::Infinity>() > 1e-10; ++it) {
-    Mat J(n, n);
-    for (int k = 0; k < n; ++k) {
-      Vec a = q, b = q;
-      a(k) += 1e-6;
-      b(k) -= 1e-6;
-      J.col(k) = (acc(a) - acc(b)) / 2e-6;
-    }
-    const Vec dq = J.partialPivLu().solve(-r);
-    // At most 0.3 rad per Newton step, then halve until the residual drops.
-    double step = std::min(1.0, 0.3 / std::max(1e-300, dq.lpNorm<Eigen::Infinity>()));
-    Vec qn = q + step * dq, rn = acc(qn);
-    for (int ls = 0; ls < 30 && !(rn.norm() < r.norm()); ++ls) {
-      step *= 0.5;
-      qn = q + step * dq;
-      rn = acc(qn);
-    }
-    q = qn;
-    r = rn;
-  }
-  if (!(r.lpNorm<Eigen::Infinity>() <= 1e-7))
-    throw std::runtime_error("no static equilibrium found (residual " +
-                             std::to_string(r.lpNorm<Eigen::Infinity>()) + " rad/s^2)");
-  return q;
-}
+/// Static equilibrium at pressures p (softrne::static_equilibrium).
+inline Vec equilibrium(const ArmDescription& d, const Vec& p, Vec q) { return static_equilibrium(d, p, std::move(q)); }
 
 /// Measured first row whose initial state (the library's measurement model inverted) is q.
 inline Vec measured_start(const ArmDescription& d, const Vec& q, const Vec& p0) {

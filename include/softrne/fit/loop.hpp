@@ -39,6 +39,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <variant>
@@ -379,6 +380,23 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     opt.log(stamp + s);
   };
+  // The loop judges by angles (its screen, noise floor and residual analysis work on them):
+  // marker columns are set aside, and data without angles are refused.
+  const auto without_markers = [](const io::Dataset& d) {
+    io::Dataset c = d;
+    c.has_markers = false;
+    c.markers.resize(d.t.size(), 0);
+    return c;
+  };
+  if (train.has_markers || (test && test->has_markers)) {
+    const io::Dataset tr = without_markers(train);
+    if (!test) return run_loop(declared, tr, nullptr, opt);
+    const io::Dataset te = without_markers(*test);
+    return run_loop(declared, tr, &te, opt);
+  }
+  if (!train.has_angles)
+    throw std::invalid_argument(train.source + ": the closed loop needs measured angles (markers alone serve "
+                                "softrne-fit, not the loop)");
   check_fit_data(declared, train);
   LoopResult out;
   const int threads = std::max(1, opt.fit.optimiser.threads);

@@ -29,6 +29,10 @@ struct Dataset {
   bool has_angles = false;  ///< the file has the angle columns (all of them)
   std::vector<std::string> pressure_names;  ///< the P pressure column names, in order
   std::vector<std::string> angle_names;     ///< the nq coordinate names (even when absent)
+  /// N x 3M measured marker positions (m, motion-capture frame), columns `<name>_x, _y, _z`
+  /// of the robot's M markers in its order (marker_column_names()); N x 0 if absent.
+  Eigen::MatrixXd markers;
+  bool has_markers = false;  ///< the file has the marker columns (all of them)
   std::string source;  ///< the file, for messages
 
   /// \brief One recording of a data set that stacks several (io::stack_recordings()).
@@ -70,15 +74,27 @@ inline bool is_indexed_name(const std::string& s, char c, bool underscore) {
 
 }  // namespace detail
 
+/// \brief The data columns of the robot's markers: `<name>_x, <name>_y, <name>_z` each.
+/// \param[in] robot The robot.
+/// \return 3 names per marker, in the robot's order.
+inline std::vector<std::string> marker_column_names(const RobotSpec& robot) {
+  std::vector<std::string> out;
+  for (const auto& m : robot.markers)
+    for (const char* axis : {"_x", "_y", "_z"}) out.push_back(m.name + axis);
+  return out;
+}
+
 /// \brief Parse the CSV text of a data set for `robot`: columns `t`, every
-/// `p{j}_{k}` of the robot, and the angle columns (all of them or none; all if
-/// `require_angles`). Other columns are ignored (not even parsed), except
+/// `p{j}_{k}` of the robot, the angle columns (all of them or none; all if
+/// `require_angles`, unless the robot's marker columns are all there) and the marker columns
+/// (marker_column_names(): all of them or none). Other columns are ignored (not even parsed), except
 /// `p{j}_{k}`, `u{j}`, `v{j}` columns the robot does not have, which mean robot
 /// and data disagree (UnexpectedColumn). `t` must increase strictly; 2 rows at least.
 /// \param[in] text The file's content.
 /// \param[in] source The file's name, for messages.
 /// \param[in] robot The robot the data belong to (its pressure and angle columns).
-/// \param[in] require_angles The angle columns must be present.
+/// \param[in] require_angles Measurements must be present: the angle columns, or for a robot
+///   with markers the angle or the marker columns.
 /// \return Times, pressures and (if present) angles, in the robot's column order.
 /// \throws InputError (MissingColumn, UnexpectedColumn, NonIncreasingTime, TooFewRows, or
 ///   as parse_csv()) naming source, line and column.
@@ -138,10 +154,17 @@ inline Dataset parse_dataset(const std::string& text, const std::string& source,
                            "): robot description and data disagree");
   }
 
+  // Marker columns: all of the robot's or none; where measurements are required, markers may
+  // stand in for the angles (a fit from motion capture alone).
+  const std::vector<std::string> marker_names = marker_column_names(robot);
+  std::size_t markers_present = 0;
+  for (const auto& name : marker_names) markers_present += index.count(name);
+  d.has_markers = !marker_names.empty() && markers_present == marker_names.size();
+
   std::size_t present = 0;
   for (const auto& name : d.angle_names) present += index.count(name);
   const std::size_t nq = d.angle_names.size();
-  if ((present > 0 && present < nq) || (present == 0 && require_angles && nq > 0)) {
+  if ((present > 0 && present < nq) || (present == 0 && require_angles && nq > 0 && !d.has_markers)) {
     for (const auto& name : d.angle_names) {
       if (index.count(name) == 0)
         throw InputError(Category::MissingColumn, source, scan.header_where(),
@@ -153,6 +176,13 @@ inline Dataset parse_dataset(const std::string& text, const std::string& source,
   d.has_angles = present == nq;
   if (d.has_angles)
     for (const auto& name : d.angle_names) wanted.push_back(index.at(name));
+  if (markers_present > 0 && markers_present < marker_names.size())
+    for (const auto& name : marker_names)
+      if (index.count(name) == 0)
+        throw InputError(Category::MissingColumn, source, scan.header_where(),
+                         "missing column '" + name + "' (marker columns must be all present or all absent)");
+  if (d.has_markers)
+    for (const auto& name : marker_names) wanted.push_back(index.at(name));
 
   std::vector<double> data;
   double t_prev = 0.0;
@@ -180,13 +210,16 @@ inline Dataset parse_dataset(const std::string& text, const std::string& source,
   d.pressures = all.middleCols(1, P);
   d.angles = d.has_angles ? Eigen::MatrixXd(all.middleCols(1 + P, static_cast<Eigen::Index>(nq)))
                           : Eigen::MatrixXd(N, 0);
+  const Eigen::Index first_marker = 1 + P + (d.has_angles ? static_cast<Eigen::Index>(nq) : 0);
+  d.markers = d.has_markers ? Eigen::MatrixXd(all.middleCols(first_marker, static_cast<Eigen::Index>(marker_names.size())))
+                            : Eigen::MatrixXd(N, 0);
   return d;
 }
 
 /// \brief Read a data set for `robot` from a CSV file (see parse_dataset).
 /// \param[in] path The file.
 /// \param[in] robot The robot the data belong to.
-/// \param[in] require_angles The angle columns must be present.
+/// \param[in] require_angles Measurements must be present (see parse_dataset()).
 /// \return Times, pressures and (if present) angles.
 /// \throws InputError (FileNotFound, ReadFailed, or as parse_dataset()).
 inline Dataset read_dataset(const std::string& path, const RobotSpec& robot, bool require_angles) {

@@ -49,6 +49,9 @@ inline Dataset recording(const Dataset& data, std::size_t k) {
   out.angles = data.has_angles ? Eigen::MatrixXd(data.angles.middleRows(r.first_row, r.rows))
                                : Eigen::MatrixXd(r.rows, 0);
   out.has_angles = data.has_angles;
+  out.markers = data.has_markers ? Eigen::MatrixXd(data.markers.middleRows(r.first_row, r.rows))
+                                 : Eigen::MatrixXd(r.rows, 0);
+  out.has_markers = data.has_markers;
   out.pressure_names = data.pressure_names;
   out.angle_names = data.angle_names;
   out.source = r.source;
@@ -74,18 +77,21 @@ inline Dataset stack_recordings(const std::vector<Dataset>& parts) {
   Dataset out;
   const Dataset& first = parts.front();
   out.has_angles = first.has_angles;
+  out.has_markers = first.has_markers;
   out.pressure_names = first.pressure_names;
   out.angle_names = first.angle_names;
   Eigen::Index rows = 0;
   for (const Dataset& p : parts) {
     if (p.pressure_names != first.pressure_names || p.has_angles != first.has_angles ||
-        p.angles.cols() != first.angles.cols())
+        p.angles.cols() != first.angles.cols() || p.has_markers != first.has_markers ||
+        p.markers.cols() != first.markers.cols())
       throw std::invalid_argument(p.source + ": its columns differ from " + first.source + "'s");
     rows += p.t.size();
   }
   out.t.resize(rows);
   out.pressures.resize(rows, first.pressures.cols());
   out.angles.resize(rows, first.angles.cols());
+  out.markers.resize(rows, first.markers.cols());
   Eigen::Index row = 0;
   for (const Dataset& p : parts) {
     const Eigen::Index n = p.t.size();
@@ -103,6 +109,7 @@ inline Dataset stack_recordings(const std::vector<Dataset>& parts) {
     out.t.segment(row, n) = p.t.array() + r.time_shift;
     out.pressures.middleRows(row, n) = p.pressures;
     out.angles.middleRows(row, n) = p.angles;
+    out.markers.middleRows(row, n) = p.markers;
     out.recordings.push_back(r);
     out.source += (row == 0 ? "" : " + ") + p.source;
     row += n;

@@ -140,6 +140,27 @@ inline EffectSpec read_effect(const nlohmann::json& v, std::size_t index, const 
   return e;
 }
 
+/// "markers[0] 'tip'".
+inline std::string marker_where(const std::string& prefix, std::size_t index, const std::string& name) {
+  std::string w = prefix + "markers[" + std::to_string(index) + "]";
+  if (!name.empty()) w += " '" + one_line(name) + "'";
+  return w;
+}
+
+inline MarkerSpec read_marker(const nlohmann::json& v, std::size_t index, const std::string& source,
+                              const std::string& prefix) {
+  const std::string where0 = marker_where(prefix, index, "");
+  require_object(v, source, where0);
+  ObjectReader r(v, source, where0);
+  MarkerSpec m;
+  m.name = r.string("name");
+  r.set_where(marker_where(prefix, index, m.name));
+  r.only({"name", "segment", "offset"});
+  m.segment = r.string("segment");
+  m.offset = r.fixed<3>("offset");
+  return m;
+}
+
 template <class Json>
 Json to_json_impl(const RobotSpec& robot) {
   auto vec = [](const auto& v) {
@@ -198,6 +219,17 @@ Json to_json_impl(const RobotSpec& robot) {
     }
     j["effects"] = std::move(effs);
   }
+  if (!robot.markers.empty()) {
+    Json marks = Json::array();
+    for (const auto& m : robot.markers) {
+      Json o = Json::object();
+      o["name"] = m.name;
+      o["segment"] = m.segment;
+      o["offset"] = vec(m.offset);
+      marks.push_back(std::move(o));
+    }
+    j["markers"] = std::move(marks);
+  }
   return j;
 }
 
@@ -230,7 +262,7 @@ inline RobotSpec robot_from_json(const nlohmann::json& j, const std::string& sou
         Category::UnknownFormat, source, r.fw("format"),
         "unknown format " + detail::quoted(format) + ", expected '" + kRobotFormat + "'" + hint);
   }
-  r.only({"format", "name", "gravity", "segments", "effects"});
+  r.only({"format", "name", "gravity", "segments", "effects", "markers"});
   RobotSpec robot;
   robot.source = source;
   robot.name = r.optional_string("name", "");
@@ -250,6 +282,14 @@ inline RobotSpec robot_from_json(const nlohmann::json& j, const std::string& sou
                        "expected an array of effects, got " + detail::describe(effs));
     for (std::size_t i = 0; i < effs.size(); ++i)
       robot.effects.push_back(detail::read_effect(effs[i], i, source, prefix));
+  }
+  if (r.has("markers")) {
+    const auto& marks = r.at("markers");
+    if (!marks.is_array())
+      throw InputError(Category::WrongType, source, r.fw("markers"),
+                       "expected an array of markers, got " + detail::describe(marks));
+    for (std::size_t i = 0; i < marks.size(); ++i)
+      robot.markers.push_back(detail::read_marker(marks[i], i, source, prefix));
   }
   detail::validate_robot_global(robot, source, prefix);
   return robot;

@@ -66,12 +66,22 @@ struct EffectSpec {
   std::string evidence;  ///< short human-readable reason
 };
 
+/// \brief A motion-capture marker: a point fixed in a segment's distal frame (issue 19).
+/// Data files carry its measured position as `<name>_x`, `<name>_y`, `<name>_z` in m, in
+/// the motion-capture frame (formats.md sections 1 and 2).
+struct MarkerSpec {
+  std::string name;     ///< its name (letters, digits, '_'; starts with a letter)
+  std::string segment;  ///< the segment whose distal frame carries it
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();  ///< in that frame, m
+};
+
 /// \brief A whole robot: `robot.json`.
 struct RobotSpec {
   std::string name;  ///< the robot's name
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< m/s^2, in the base frame
   std::vector<SegmentSpec> segments;  ///< base to tip
   std::vector<EffectSpec> effects;    ///< effects added by a fit (empty when declared)
+  std::vector<MarkerSpec> markers;    ///< motion-capture markers (may be empty)
   std::string source;  ///< the file it was read from, for messages
 };
 

@@ -3,6 +3,8 @@
 /// \brief Semantic checks of a RobotSpec (ranges, names, shapes), shared by the
 /// JSON reader and writer and usable on a spec built in code.
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstddef>
 #include <set>
@@ -205,6 +207,29 @@ inline void validate_robot_global(const RobotSpec& robot, const std::string& sou
                          "chamber>'");
       NumberCheck{source, field_where(where, "params." + key)}.finite(value);
     }
+  }
+  // Markers: a name that makes data columns <name>_x, _y, _z no other column has (not t,
+  // p.._.., u.., v..), unique; a segment of the robot; a finite offset.
+  std::set<std::string> marker_names;
+  for (std::size_t k = 0; k < robot.markers.size(); ++k) {
+    const MarkerSpec& m = robot.markers[k];
+    std::string where = prefix + "markers[" + std::to_string(k) + "]";
+    if (!m.name.empty()) where += " '" + one_line(m.name) + "'";
+    const bool identifier =
+        !m.name.empty() && std::isalpha(static_cast<unsigned char>(m.name[0])) &&
+        std::all_of(m.name.begin(), m.name.end(),
+                    [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+    if (!identifier)
+      throw InputError(Category::InvalidValue, source, field_where(where, "name"),
+                       "a marker name is a letter followed by letters, digits or '_' (its data "
+                       "columns are <name>_x, <name>_y, <name>_z)");
+    if (!marker_names.insert(m.name).second)
+      throw InputError(Category::DuplicateName, source, field_where(where, "name"), "duplicate marker name");
+    if (names.count(m.segment) == 0)
+      throw InputError(Category::UnknownName, source, field_where(where, "segment"),
+                       "no segment is named " + quoted(m.segment));
+    for (int i = 0; i < 3; ++i)
+      NumberCheck{source, field_where(where, "offset[" + std::to_string(i) + "]")}.finite(m.offset[i]);
   }
 }
 

@@ -80,22 +80,25 @@ inline ErrorStats error_stats(const Eigen::MatrixXd& simulated, const Eigen::Mat
   return out;
 }
 
-/// \brief The table as text, like the paper's Tables I-II (radians).
+/// \brief The table as text, like the paper's Tables I-II (radians; or marker distances, mm).
 /// \param[in] s The statistics.
 /// \param[in] title The first line.
+/// \param[in] what The first column's heading ("angle", "marker").
+/// \param[in] unit The unit after the total line ("rad", "mm").
 /// \return The table, one line per angle and a total line.
-inline std::string format_error_table(const ErrorStats& s, const std::string& title) {
+inline std::string format_error_table(const ErrorStats& s, const std::string& title,
+                                      const std::string& what = "angle", const std::string& unit = "rad") {
   std::string out = title + "\n";
   char line[160];
-  std::snprintf(line, sizeof line, "  %-10s %10s %10s %10s\n", "angle", "mean", "median", "max");
+  std::snprintf(line, sizeof line, "  %-10s %10s %10s %10s\n", what.c_str(), "mean", "median", "max");
   out += line;
   for (std::size_t i = 0; i < s.per_angle.size(); ++i) {
     std::snprintf(line, sizeof line, "  %-10s %10.4f %10.4f %10.4f\n", s.names[i].c_str(),
                   s.per_angle[i].mean, s.per_angle[i].median, s.per_angle[i].max);
     out += line;
   }
-  std::snprintf(line, sizeof line, "  %-10s %10.4f %10.4f %10.4f   (rad)\n", "total", s.total.mean,
-                s.total.median, s.total.max);
+  std::snprintf(line, sizeof line, "  %-10s %10.4f %10.4f %10.4f   (%s)\n", "total", s.total.mean,
+                s.total.median, s.total.max, unit.c_str());
   out += line;
   return out;
 }
