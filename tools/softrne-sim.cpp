@@ -15,6 +15,7 @@
 #include "common/cli.hpp"
 #include "common/outputs.hpp"
 #include "softrne/arm/arm_description.hpp"
+#include "softrne/arm/markers.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
 #include "softrne/signals/error_stats.hpp"
@@ -173,20 +174,28 @@ int run_sim(int argc, char** argv) {
     throw Failure(data_path + ": " + sim.result.message + hint);
   }
 
+  // The simulated angles and, for a robot with markers, their positions in the base frame.
+  std::vector<std::string> columns = desc.coordinate_names;
+  const std::vector<std::string> marker_columns = softrne::io::marker_column_names(robot);
+  columns.insert(columns.end(), marker_columns.begin(), marker_columns.end());
+  Eigen::MatrixXd simulated(n, static_cast<Eigen::Index>(columns.size()));
+  simulated.leftCols(desc.nq) = sim.angles;
+  if (!marker_columns.empty()) simulated.rightCols(static_cast<Eigen::Index>(marker_columns.size())) =
+      softrne::marker_positions(desc, sim.states);
   std::ostream& report = out_path == "-" ? std::cerr : std::cout;
   if (out_path == "-") {
     std::vector<std::string> header{"t"};
-    header.insert(header.end(), desc.coordinate_names.begin(), desc.coordinate_names.end());
-    Eigen::MatrixXd values(n, 1 + desc.nq);
+    header.insert(header.end(), columns.begin(), columns.end());
+    Eigen::MatrixXd values(n, 1 + simulated.cols());
     values.col(0) = data.t;
-    values.rightCols(desc.nq) = sim.angles;
+    values.rightCols(simulated.cols()) = simulated;
     std::cout << softrne::io::format_csv(header, values);
     std::cout.flush();
     if (!std::cout)
       throw softrne::io::InputError(softrne::io::Category::WriteFailed, "<stdout>", "",
                                     "cannot write the simulated angles");
   } else if (!out_path.empty()) {
-    softrne::io::write_trajectory_csv(out_path, data.t, sim.angles, desc.coordinate_names);
+    softrne::io::write_trajectory_csv(out_path, data.t, simulated, columns);
   }
 
   if (data.has_angles) {

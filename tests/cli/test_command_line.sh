@@ -108,7 +108,7 @@ usage "$fit" "--out is the second --data" "refusing to overwrite an input" --rob
   --data "$test" --out "$test"
 
 # ---- several recordings: one file per --data/--train/--test, each once ------------------------
-usage "$fit" "--data a b" "unexpected argument: '$test'" --robot "$robot" --data "$train" "$test" \
+usage "$fit" "--data a b" "unexpected argument: '" --robot "$robot" --data "$train" "$test" \
   --out "$tmp/fitted.json"
 usage "$fit" "a file given twice" "--data: $train is given twice" --robot "$robot" --data "$train" \
   --data "$train" --out "$tmp/fitted.json"

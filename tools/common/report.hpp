@@ -83,9 +83,22 @@ inline nlohmann::ordered_json unexplained_json(const fit::UnexplainedResidual& u
 /// and where a held-out data set is given the errors of both models on it.
 struct FitRun {
   fit::ArmFitResult result;
-  signals::ErrorStats train_before;
+  /// What the objective held: "all" the data's measurements, "angles" or "markers" only.
+  std::string fit_to = "all";
+  bool has_angles = true;  ///< the data have angles (else only the marker errors mean anything)
+  signals::ErrorStats train_before, train_after;  ///< angles, rad
   bool has_test = false;
   signals::ErrorStats test_before, test_after;
+  /// Data with markers: their errors (mm) before and after, whether or not the objective held
+  /// them. The starting model is measured in the frame fitted in closed form to its own
+  /// training simulation, the fitted model in its fitted frame (`frame`: the fit's own when
+  /// the objective held the markers, with standard errors; else fitted in closed form to the
+  /// fitted model's training simulation), the test data in the training frame.
+  bool has_markers = false;
+  signals::ErrorStats markers_train_before, markers_train_after, markers_test_before, markers_test_after;
+  bool frame_per_recording = false;  ///< one capture frame per training recording
+  std::vector<CaptureFrame> frames;  ///< one, or one per training recording
+  std::vector<Eigen::VectorXd> frame_std_errors;  ///< empty where the objective did not hold the markers
 };
 
 /// \brief Error statistics of model `d` simulated on `data`; cli::Failure naming the data set
@@ -100,23 +113,66 @@ inline signals::ErrorStats simulated_errors(const ArmDescription& d, const io::D
 }
 
 /// \brief Fits `desc` to `train` (fit::fit_arm) and measures it before and after, on `train`
-/// and on `test` if given. cli::Failure when a model does not simulate or the fit finds no
-/// parameters that do.
+/// and on `test` if given: angle errors where the data have angles, marker errors where they
+/// have markers, whatever the objective held. `fit_to`: "all" (every measurement the data
+/// have), "angles" or "markers" (the other columns are set aside for the fit, and a recording
+/// fitted without its angles starts at rest in the equilibrium of its first pressures: a fit
+/// that never sees an angle). cli::Failure when a model does not simulate, the fit finds no
+/// parameters that do, or the data lack what fit_to asks for.
 inline FitRun run_fit(const ArmDescription& desc, const io::Dataset& train, const io::Dataset* test,
-                      const fit::ArmFitOptions& opt) {
+                      const fit::ArmFitOptions& opt, const std::string& fit_to = "all") {
   FitRun run;
-  run.train_before = simulated_errors(desc, train, opt.simulation, "starting");
+  run.fit_to = fit_to;
+  run.has_angles = train.has_angles;
+  run.has_markers = train.has_markers && !desc.spec.markers.empty();
+  io::Dataset objective = train;
+  if (fit_to == "angles") {
+    if (!train.has_angles) throw Failure(train.source + ": --fit-to angles, but the data have no angle columns");
+    objective.has_markers = false;
+    objective.markers.resize(train.t.size(), 0);
+  } else if (fit_to == "markers") {
+    if (!run.has_markers) throw Failure(train.source + ": --fit-to markers, but the data have no marker columns of the robot's markers");
+    objective.has_angles = false;
+    objective.angles.resize(train.t.size(), 0);
+    objective.recordings = {};  // initial rates come from angles: without them, from rest
+    for (auto r : train.recordings) {
+      r.initial_rates.resize(0);
+      objective.recordings.push_back(r);
+    }
+  }
+  if (run.has_angles) run.train_before = simulated_errors(desc, train, opt.simulation, "starting");
   try {
-    run.result = fit::fit_arm(desc, train, opt);
+    run.result = fit::fit_arm(desc, objective, opt);
   } catch (const std::invalid_argument& e) {
     throw Failure(e.what());
   }
   if (!std::isfinite(run.result.fit.cost))
     throw Failure(train.source + ": the fit found no parameters that simulate: " + run.result.fit.message);
+  const ArmDescription& fitted = run.result.fitted;
+  if (run.has_angles)
+    run.train_after = objective.has_angles ? run.result.stats : simulated_errors(fitted, train, opt.simulation, "fitted");
   if (test) {
     run.has_test = true;
-    run.test_before = simulated_errors(desc, *test, opt.simulation, "starting");
-    run.test_after = simulated_errors(run.result.fitted, *test, opt.simulation, "fitted");
+    if (test->has_angles) {
+      run.test_before = simulated_errors(desc, *test, opt.simulation, "starting");
+      run.test_after = simulated_errors(fitted, *test, opt.simulation, "fitted");
+    }
+  }
+  if (run.has_markers) {
+    const bool per = run.frame_per_recording = opt.capture_frame_per_recording;
+    std::vector<CaptureFrame> start_frames;
+    run.markers_train_before = fit::marker_errors(desc, train, opt.simulation, per, nullptr, &start_frames);
+    if (objective.has_markers) {
+      run.frames = run.result.capture_frames;
+      run.frame_std_errors = run.result.capture_frame_std_errors;
+      run.markers_train_after = run.result.marker_stats;
+    } else {
+      run.markers_train_after = fit::marker_errors(fitted, train, opt.simulation, per, nullptr, &run.frames);
+    }
+    if (test && test->has_markers) {
+      run.markers_test_before = fit::marker_errors(desc, *test, opt.simulation, per, &start_frames);
+      run.markers_test_after = fit::marker_errors(fitted, *test, opt.simulation, per, &run.frames);
+    }
   }
   return run;
 }
@@ -138,8 +194,40 @@ inline nlohmann::ordered_json fit_report_json(const FitRun& run) {
   }
   j["parameters"] = params;
   j["identifiability"] = r.fit.identifiability_report;
-  j["train"] = {{"before", stats_json(run.train_before)}, {"after", stats_json(r.stats)}};
-  if (run.has_test) j["test"] = {{"before", stats_json(run.test_before)}, {"after", stats_json(run.test_after)}};
+  // Angle errors (rad) where the data have angles: without them (markers only) null.
+  const auto angle_stats = [&](const signals::ErrorStats& e) -> nlohmann::ordered_json {
+    return run.has_angles ? stats_json(e) : nlohmann::ordered_json(nullptr);
+  };
+  j["train"] = {{"before", angle_stats(run.train_before)}, {"after", angle_stats(run.train_after)}};
+  if (run.has_test) j["test"] = {{"before", angle_stats(run.test_before)}, {"after", angle_stats(run.test_after)}};
+  if (run.fit_to != "all") j["fit_to"] = run.fit_to;
+  if (run.has_markers) {
+    // Marker errors in mm (per marker the distance between simulated and measured positions)
+    // and the capture frame: y_capture = R x_base + t.
+    nlohmann::ordered_json m;
+    m["unit"] = "mm";
+    m["train"] = {{"before", stats_json(run.markers_train_before)}, {"after", stats_json(run.markers_train_after)}};
+    if (run.has_test)
+      m["test"] = {{"before", stats_json(run.markers_test_before)}, {"after", stats_json(run.markers_test_after)}};
+    j["markers"] = m;
+    // One frame (shared by all training recordings) or one per training recording.
+    nlohmann::ordered_json frames = nlohmann::ordered_json::array();
+    for (std::size_t g = 0; g < run.frames.size(); ++g) {
+      const CaptureFrame& f = run.frames[g];
+      nlohmann::ordered_json R = nlohmann::ordered_json::array();
+      for (int i = 0; i < 3; ++i) R.push_back({f.R(i, 0), f.R(i, 1), f.R(i, 2)});
+      nlohmann::ordered_json se = nullptr;
+      if (g < run.frame_std_errors.size() && run.frame_std_errors[g].size() == 6) {
+        se = nlohmann::ordered_json::array();
+        for (Eigen::Index i = 0; i < 6; ++i) se.push_back(finite_or_null(run.frame_std_errors[g](i)));
+      }
+      frames.push_back({{"rotation", R}, {"translation", {f.t(0), f.t(1), f.t(2)}}, {"std_errors", se}});
+    }
+    j["capture_frames"] = {{"per_recording", run.frame_per_recording},
+                           {"frames", frames},
+                           {"std_errors_meaning", "rotation about the capture x, y, z axes (rad), then translation "
+                                                  "(m); null where the fit did not use the markers"}};
+  }
   j["converged"] = r.fit.converged;
   j["message"] = r.fit.message;
   j["simulations"] = r.simulations;
