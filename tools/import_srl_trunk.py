@@ -7,7 +7,8 @@ inside the repository) and writes, into --out (a build folder outside git):
 
   robot.json           softrne-robot/1: two CC joints with a 3-chamber pressure_to_torque,
                        the middle connector and the gripper as rigid links, hanging arm
-  <log>.csv            one data set per log: t, p1_0..p1_2, p2_0..p2_2 (Pa), u1, v1, u2, v2 (rad)
+  <log>.csv            one data set per log: t, p1_0..p1_2, p2_0..p2_2 (Pa), u1, v1, u2, v2 (rad),
+                       tip_x, tip_y, tip_z (m, the motion-capture tip: the robot's marker 'tip')
   conventions.md/.json the angle-convention check: RMS of the mocap tip against the CC forward
                        kinematics of the logged angles, per candidate convention
   import-summary.json  what was read, dropped, chosen
@@ -332,7 +333,10 @@ def make_robot(S, stiffness_guess, damping_guess):
         # The chain's base frame has z pointing down along the hanging arm (the straight arm
         # is exp(0): tip at +z), so gravity in the base frame is +9.81 along z.
         "gravity": [0.0, 0.0, 9.81],
-        "segments": segs}
+        "segments": segs,
+        # The logs' x, y, z: the gripper's end measured by motion capture (in a frame of
+        # its own per log: the fit estimates it, softrne-fit --frame-per-recording).
+        "markers": [{"name": "tip", "segment": "gripper", "offset": [0.0, 0.0, 0.0]}]}
     return robot, info
 
 
@@ -364,9 +368,11 @@ def write_dataset(path, log, S, source):
         f.write("# pressures: commanded, mbar*100 -> Pa; angles: (u,v) = S (Lx,Ly), S = %s\n" % S.tolist())
         f.write("# irregular sampling kept as logged (%d rows, %d non-increasing timestamps dropped)\n"
                 % (len(t), log["_dropped_nonincreasing"]))
-        f.write("t,p1_0,p1_1,p1_2,p2_0,p2_1,p2_2,u1,v1,u2,v2\n")
+        f.write("# tip_x, tip_y, tip_z: the logged x, y, z (m), motion-capture tip position\n")
+        f.write("t,p1_0,p1_1,p1_2,p2_0,p2_1,p2_2,u1,v1,u2,v2,tip_x,tip_y,tip_z\n")
         for i in range(len(t)):
-            f.write(",".join(["%.4f" % t[i]] + ["%.3f" % x for x in P[i]] + ["%.6f" % x for x in q[i]]) + "\n")
+            f.write(",".join(["%.4f" % t[i]] + ["%.3f" % x for x in P[i]] + ["%.6f" % x for x in q[i]] +
+                             ["%.6f" % x for x in X[i]]) + "\n")
 
 
 def main():

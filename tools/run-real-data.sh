@@ -9,12 +9,15 @@
 # 3. fits stiffness and damping on the training log (softrne-fit, with uncertainties),
 # 4. runs the closed loop (softrne-loop) on training + test log, with plots,
 # 5. measures the baseline and the final model on the other test logs (softrne-sim) and
-#    writes $BUILD_DIR/srl/results.md.
+#    writes $BUILD_DIR/srl/results.md,
+# 6. fits several logs that start in motion from their angles alone and from the tip marker
+#    alone, compares both on held-out logs, and runs the loop on the several logs (results.md).
 # The data is read from ../shared/data/real/srl-3d-soft-trunk (relative to the repository) or
 # $SRL_DATA; when it is absent the script says so and exits 0 without doing anything.
 # Environment: BUILD_DIR, JOBS (default 2), SRL_DATA, PYTHON (default: the first python3 with numpy and scipy),
 # SRL_TRAIN (default MPC_logger_ts1), SRL_TEST (default MPC_logger_ts2),
-# SRL_MORE_TESTS (default "MPC_logger_ts3 MPC_logger_tube1 MPC_logger_tube2 MPC_logger_tube3").
+# SRL_MORE_TESTS (default "MPC_logger_ts3 MPC_logger_tube1 MPC_logger_tube2 MPC_logger_tube3"),
+# SRL_MULTI_TRAIN, SRL_MULTI_TEST (item 6: default ts1 tube1 tube2 / ts2 ts3 tube3).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -39,6 +42,9 @@ fi
 train=${SRL_TRAIN:-MPC_logger_ts1}
 test=${SRL_TEST:-MPC_logger_ts2}
 more_tests=${SRL_MORE_TESTS:-MPC_logger_ts3 MPC_logger_tube1 MPC_logger_tube2 MPC_logger_tube3}
+# Item 6: logs of one arm build (the same commit of the SRL code), several for training.
+multi_train=${SRL_MULTI_TRAIN:-MPC_logger_ts1 MPC_logger_tube1 MPC_logger_tube2}
+multi_test=${SRL_MULTI_TEST:-MPC_logger_ts2 MPC_logger_ts3 MPC_logger_tube3}
 out="$build_dir/srl"
 
 if [[ ! -d "$data/longitudinal_q" ]]; then
@@ -61,8 +67,9 @@ run "$py" tools/import_srl_trunk.py --data "$data" --out "$out" --guess-logs "$t
 mv "$out.import.log" "$out/import.log"
 
 # 3. Baseline fit of K and D with parameter uncertainties.
+# (--fit-to angles: the tip marker columns are item 6's.)
 run "$bin/softrne-fit" --robot "$out/robot.json" --data "$out/$train.csv" --test "$out/$test.csv" \
-  --out "$out/fitted.json" --quiet 2>&1 | tee "$out/fit.log"
+  --fit-to angles --out "$out/fitted.json" --quiet 2>&1 | tee "$out/fit.log"
 
 # 4. The closed loop (plots when matplotlib is there: softrne-loop calls tools/plot_loop.py).
 plots=()
@@ -121,4 +128,58 @@ for log in logs:
 open(os.path.join(out, "results.md"), "w").write("\n".join(lines) + "\n")
 print("\n".join(lines))
 EOF
-echo "[run-real-data] outputs in $out (robot.json, conventions.md, fit.log, loop-report.json, plots/, results.md)"
+# 6. Several logs of one arm build that start in motion, and the tip marker (issue 19 item 4):
+#    fitted from the angles alone and from the motion-capture tip alone (a frame per log: the
+#    logs' capture frames differ), both measured on held-out logs in angle and tip error; then
+#    the closed loop on the several training logs, held-out logs before and after.
+fit_multi() {  # fit_multi <what the objective holds>
+  "$bin/softrne-fit" --robot "$out/robot.json" "${multi_data[@]}" "${multi_tests[@]}" --initial-motion estimated \
+    --frame-per-recording --fit-to "$1" --out "$out/multi-fit-$1.json" --report "$out/multi-fit-$1-report.json" \
+    --quiet > "$out/multi-fit-$1.log" 2>&1
+}
+multi_data=() multi_tests=() multi_train_args=()
+for log in $multi_train; do multi_data+=(--data "$out/$log.csv"); multi_train_args+=(--train "$out/$log.csv"); done
+for log in $multi_test; do multi_tests+=(--test "$out/$log.csv"); done
+run fit_multi angles
+run fit_multi markers
+run "$bin/softrne-loop" --robot "$out/robot.json" "${multi_train_args[@]}" "${multi_tests[@]}" \
+  --initial-motion estimated --out "$out/multi-loop-report.json" > "$out/multi-loop.log" 2>&1
+"$py" - "$out" <<'EOF'
+import json, os, sys
+out = sys.argv[1]
+fa, fm = (json.load(open(os.path.join(out, "multi-fit-%s-report.json" % w))) for w in ("angles", "markers"))
+loop = json.load(open(os.path.join(out, "multi-loop-report.json")))
+def tip(rep, part):
+    return rep["markers"][part]["after"]["median"]
+rows = ["", "## Several logs, angles or the tip marker (issue 19 item 4)", "",
+        "train: %s; held out: %s; each log from its estimated initial rates; one capture frame per log"
+        % (", ".join(os.path.basename(r["source"]) for r in loop["recordings"]["train"]),
+           ", ".join(os.path.basename(r["source"]) for r in loop["recordings"]["test"])), "",
+        "| fitted to | test angle median (rad) | test tip median (mm) | train angle median (rad) | train tip median (mm) |",
+        "| --- | --- | --- | --- | --- |"]
+for name, rep in (("angles only", fa), ("tip marker only (never saw an angle)", fm)):
+    rows.append("| %s | %.4f | %.1f | %.4f | %.1f |" % (name, rep["test"]["after"]["median"], tip(rep, "test"),
+                                                      rep["train"]["after"]["median"], tip(rep, "train")))
+rows += ["", "| parameter | fitted to angles | fitted to the tip |", "| --- | --- | --- |"]
+pm = {p["name"]: p for p in fm["parameters"]}
+def fmt(x):
+    se = x.get("std_error")
+    return "%.4g +- %s" % (x["value"], "%.2g" % se if se is not None else "?")
+for p in fa["parameters"]:
+    q = pm.get(p["name"])
+    rows.append("| %s | %s | %s |" % (p["name"], fmt(p), fmt(q) if q else "-"))
+def effect(e):
+    params = ", ".join("%s %.3g +- %s" % (k, v, "%.2g" % e["std_errors"][k] if e["std_errors"].get(k) is not None else "?")
+                       for k, v in e["params"].items())
+    return "%s (%s %s: %s)" % (e["name"], e["scope"], " ".join(e["joints"]), params)
+rows += ["", "closed loop on the training logs (folds hold out whole logs): added " +
+         ("; ".join(effect(e) for e in loop["effects"]) or "nothing") +
+         ". Test median %.4f -> %.4f rad; per held-out log:" % (loop["baseline"]["test"]["median"],
+                                                              loop["final"]["test"]["median"])]
+for r in loop["recordings"]["test_medians"]:
+    rows.append("- %s: %.4f -> %.4f rad" % (os.path.basename(r["source"]), r["baseline_median"], r["final_median"]))
+with open(os.path.join(out, "results.md"), "a") as f:
+    f.write("\n".join(rows) + "\n")
+print("\n".join(rows))
+EOF
+echo "[run-real-data] outputs in $out (robot.json, conventions.md, fit.log, loop-report.json, plots/, multi-*, results.md)"
