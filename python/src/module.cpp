@@ -32,6 +32,7 @@
 #include <numpy/arrayobject.h>
 
 #include "common/report.hpp"
+#include "softrne/algorithms/derivatives.hpp"
 #include "softrne/arm/arm_description.hpp"
 #include "softrne/fit/arm_fit.hpp"
 #include "softrne/fit/loop.hpp"
@@ -624,6 +625,42 @@ NB_MODULE(_softrne, m) {
       "q"_a, "qd"_a, "tau"_a, "threads"_a = 0,
       (std::string("Forward dynamics in O(n) by the articulated-body recursion (same result as "
                    "forward_dynamics, without forming M).") +
+       kThreadsDoc)
+          .c_str());
+  robot.def(
+      "rnea_derivatives",
+      [](Robot& r, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& qdd, int threads) {
+        const States s = states(r, "rnea_derivatives", {{"q", q}, {"qd", qd}, {"qdd", qdd}});
+        const int nq = r.nq();
+        const auto n = static_cast<size_t>(nq);
+        return evaluate(r, s, {3, n, n}, threads, [nq, &r](Data& d, const double* const* in, double* out) {
+          softrne::rnea_derivatives(r.chain, d, CVec(in[0], nq), CVec(in[1], nq), CVec(in[2], nq));
+          Eigen::Map<RowMatrix>(out, nq, nq) = d.dtau_dq;
+          Eigen::Map<RowMatrix>(out + nq * nq, nq, nq) = d.dtau_dqdot;
+          Eigen::Map<RowMatrix>(out + 2 * nq * nq, nq, nq) = d.mass_matrix;
+        });
+      },
+      "q"_a, "qd"_a, "qdd"_a, "threads"_a = 0,
+      (std::string("The partial derivatives of rnea (softrne::rnea_derivatives, exact: forward-mode AutoDiff "
+                   "through the RNE), stacked as shape (3, nq, nq): d tau/d q, d tau/d qd, d tau/d qdd = M(q).") +
+       kThreadsDoc)
+          .c_str());
+  robot.def(
+      "aba_derivatives",
+      [](Robot& r, const ArrayLike& q, const ArrayLike& qd, const ArrayLike& tau, int threads) {
+        const States s = states(r, "aba_derivatives", {{"q", q}, {"qd", qd}, {"tau", tau}});
+        const int nq = r.nq();
+        const auto n = static_cast<size_t>(nq);
+        return evaluate(r, s, {3, n, n}, threads, [nq, &r](Data& d, const double* const* in, double* out) {
+          softrne::aba_derivatives(r.chain, d, CVec(in[0], nq), CVec(in[1], nq), CVec(in[2], nq));
+          Eigen::Map<RowMatrix>(out, nq, nq) = d.dqddot_dq;
+          Eigen::Map<RowMatrix>(out + nq * nq, nq, nq) = d.dqddot_dqdot;
+          Eigen::Map<RowMatrix>(out + 2 * nq * nq, nq, nq) = d.dqddot_dtau;
+        });
+      },
+      "q"_a, "qd"_a, "tau"_a, "threads"_a = 0,
+      (std::string("The partial derivatives of forward dynamics (softrne::aba_derivatives, exact), stacked as "
+                   "shape (3, nq, nq): d qdd/d q, d qdd/d qd, d qdd/d tau = M(q)^-1.") +
        kThreadsDoc)
           .c_str());
   robot.def(

@@ -219,3 +219,31 @@ def test_bad_values_raise_value_error(robot):
         robot.rnea(z, "abc", z)
     with pytest.raises(ValueError, match="q is not an array of numbers"):
         robot.rnea([[0.0] * 6, [0.0] * 5], z, z)
+
+
+def test_derivatives_against_central_differences(robot, rng):
+    """rnea_derivatives and aba_derivatives (exact, AutoDiff in C++) against central
+    differences of rnea and aba through the same Python API (step 1e-6: truncation ~1e-12,
+    roundoff ~1e-10 of the forces' size); the third block is M and M^-1; batched == singles."""
+    q, qd, qdd, tau = random_states(rng, 4, robot.nq)
+    h = 1e-6
+    eye = np.eye(robot.nq)
+
+    def central(f, x):
+        return np.stack([(f(x + h * e) - f(x - h * e)) / (2 * h) for e in eye], axis=1)
+
+    for k in range(len(q)):
+        D = robot.rnea_derivatives(q[k], qd[k], qdd[k])
+        assert D.shape == (3, robot.nq, robot.nq)
+        np.testing.assert_allclose(D[0], central(lambda x: robot.rnea(x, qd[k], qdd[k]), q[k]), rtol=0, atol=1e-7)
+        np.testing.assert_allclose(D[1], central(lambda x: robot.rnea(q[k], x, qdd[k]), qd[k]), rtol=0, atol=1e-7)
+        np.testing.assert_allclose(D[2], robot.mass_matrix(q[k]), rtol=0, atol=1e-12)
+        A = robot.aba_derivatives(q[k], qd[k], tau[k])
+        scale = max(1.0, np.abs(robot.aba(q[k], qd[k], tau[k])).max())
+        np.testing.assert_allclose(A[0], central(lambda x: robot.aba(x, qd[k], tau[k]), q[k]), rtol=0, atol=1e-6 * scale)
+        np.testing.assert_allclose(A[1], central(lambda x: robot.aba(q[k], x, tau[k]), qd[k]), rtol=0, atol=1e-6 * scale)
+        np.testing.assert_allclose(A[2] @ robot.mass_matrix(q[k]), eye, rtol=0, atol=1e-9)
+    batched = robot.rnea_derivatives(q, qd, qdd)
+    assert batched.shape == (len(q), 3, robot.nq, robot.nq)
+    np.testing.assert_array_equal(batched[2], robot.rnea_derivatives(q[2], qd[2], qdd[2]))
+    np.testing.assert_array_equal(robot.aba_derivatives(q, qd, tau)[1], robot.aba_derivatives(q[1], qd[1], tau[1]))

@@ -83,15 +83,23 @@ inline Dataset stack_recordings(const std::vector<Dataset>& parts) {
   Eigen::Index rows = 0;
   for (const Dataset& p : parts) {
     if (p.pressure_names != first.pressure_names || p.has_angles != first.has_angles ||
-        p.angles.cols() != first.angles.cols() || p.has_markers != first.has_markers ||
-        p.markers.cols() != first.markers.cols())
-      throw std::invalid_argument(p.source + ": its columns differ from " + first.source + "'s");
+        p.has_markers != first.has_markers || p.pressures.cols() != first.pressures.cols() ||
+        p.pressures.rows() != p.t.size() || (p.has_angles && p.angles.cols() != first.angles.cols()) ||
+        (p.has_angles && p.angles.rows() != p.t.size()) ||
+        (p.has_markers && p.markers.cols() != first.markers.cols()) ||
+        (p.has_markers && p.markers.rows() != p.t.size()))
+      throw std::invalid_argument(p.source + ": its columns differ from " + first.source + "'s (or its "
+                                  "tables' sizes disagree)");
     rows += p.t.size();
   }
   out.t.resize(rows);
   out.pressures.resize(rows, first.pressures.cols());
-  out.angles.resize(rows, first.angles.cols());
-  out.markers.resize(rows, first.markers.cols());
+  // Angles and markers only where the data have them (N x 0 otherwise, whatever shape an
+  // absent block was given).
+  const Eigen::Index na = first.has_angles ? first.angles.cols() : 0;
+  const Eigen::Index nm = first.has_markers ? first.markers.cols() : 0;
+  out.angles.resize(rows, na);
+  out.markers.resize(rows, nm);
   Eigen::Index row = 0;
   for (const Dataset& p : parts) {
     const Eigen::Index n = p.t.size();
@@ -108,8 +116,8 @@ inline Dataset stack_recordings(const std::vector<Dataset>& parts) {
     }
     out.t.segment(row, n) = p.t.array() + r.time_shift;
     out.pressures.middleRows(row, n) = p.pressures;
-    out.angles.middleRows(row, n) = p.angles;
-    out.markers.middleRows(row, n) = p.markers;
+    if (na > 0) out.angles.middleRows(row, n) = p.angles;
+    if (nm > 0) out.markers.middleRows(row, n) = p.markers;
     out.recordings.push_back(r);
     out.source += (row == 0 ? "" : " + ") + p.source;
     row += n;
