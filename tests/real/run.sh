@@ -19,7 +19,7 @@ fi
 mkdir -p "$work"
 "$py" "$repo/tools/import_srl_trunk.py" --data "$data" --out "$work" --guess-logs MPC_logger_ts1 > "$work/import.log"
 "$bin/softrne-fit" --robot "$work/robot.json" --data "$work/MPC_logger_ts1.csv" \
-  --test "$work/MPC_logger_ts2.csv" --out "$work/fitted.json" --quiet > "$work/fit.log" 2>&1
+  --test "$work/MPC_logger_ts2.csv" --fit-to angles --out "$work/fitted.json" --quiet > "$work/fit.log" 2>&1
 "$py" - "$work" <<'PY'
 import json, re, sys
 w = sys.argv[1]
