@@ -92,8 +92,7 @@ int main(int argc, char** argv) {
     io::write_robot_json(to_robot_spec(r.fitted), out_path);
     if (!report_path.empty()) {
       nlohmann::ordered_json report = cli::fit_report_json(run);
-      if (!train.recordings.empty() || !test.recordings.empty())
-        report["recordings"] = {{"train", cli::recordings_json(train)}, {"test", cli::recordings_json(test)}};
+      cli::add_recordings(report, train, has_test ? &test : nullptr);
       io::detail::write_text_file(report_path, report.dump(2) + "\n");
     }
     std::printf("fitted %d parameters in %.1f s (%d simulations)\n", r.parameters.size(), r.wall_seconds, r.simulations);

@@ -117,24 +117,8 @@ int main(int argc, char** argv) {
     if (!plots_dir.empty()) write_plot_data(plots_dir, r, train, test, opt);
     nlohmann::ordered_json report = cli::loop_report_json(r, true, opt);
     // Per held-out recording, the median error before and after (several test recordings).
-    std::vector<std::pair<std::string, double>> test_before, test_after;
-    if (test.recordings.size() >= 2) {
-      const auto before = fit::simulate_dataset(r.baseline.fitted, test, opt.fit.simulation);
-      const auto after = fit::simulate_dataset(r.final_fit.fitted, test, opt.fit.simulation);
-      const auto& names = r.final_fit.fitted.coordinate_names;
-      if (before.ok()) test_before = cli::recording_medians(test, before.angles, names);
-      if (after.ok()) test_after = cli::recording_medians(test, after.angles, names);
-    }
-    if (!train.recordings.empty() || !test.recordings.empty()) {
-      nlohmann::ordered_json per = nlohmann::ordered_json::array();
-      for (std::size_t k = 0; k < test_before.size() && k < test_after.size(); ++k)
-        per.push_back({{"source", test_before[k].first},
-                       {"baseline_median", test_before[k].second},
-                       {"final_median", test_after[k].second}});
-      report["recordings"] = {{"train", cli::recordings_json(train)},
-                              {"test", cli::recordings_json(test)},
-                              {"test_medians", per}};
-    }
+    const std::vector<cli::RecordingMedians> medians = cli::loop_test_medians(r, test, opt);
+    cli::add_recordings(report, train, &test, &medians);
     io::detail::write_text_file(out_path, report.dump(2) + "\n");
     std::printf("closed loop in %.1f s (%d simulations)\n", r.wall_seconds, r.simulations);
     std::printf("sensor noise estimated from the training angles: floor (median |error| of noise alone) %.4f rad\n",
@@ -174,9 +158,8 @@ int main(int argc, char** argv) {
     std::printf("%s", format_error_table(r.final_train, "train, final").c_str());
     std::printf("%s", format_error_table(r.baseline_test, "test, baseline").c_str());
     std::printf("%s", format_error_table(r.final_test, "test, final").c_str());
-    for (std::size_t k = 0; k < test_before.size() && k < test_after.size(); ++k)
-      std::printf("  %s: median error %.4f -> %.4f rad\n", test_before[k].first.c_str(), test_before[k].second,
-                  test_after[k].second);
+    for (const auto& m : medians)
+      std::printf("  %s: median error %.4f -> %.4f rad\n", m.source.c_str(), m.baseline, m.final);
     std::printf("test median error: %.4f -> %.4f rad\nwrote %s\n", r.baseline_test.total.median,
                 r.final_test.total.median, out_path.c_str());
     return cli::kExitOk;

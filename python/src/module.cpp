@@ -31,6 +31,7 @@
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 
+#include "common/recordings.hpp"
 #include "common/report.hpp"
 #include "softrne/algorithms/derivatives.hpp"
 #include "softrne/arm/arm_description.hpp"
@@ -787,20 +788,42 @@ NB_MODULE(_softrne, m) {
       "SimulationError if the integration fails.");
 
   m.def(
+      "_stack_recordings",
+      [](const std::vector<softrne::io::Dataset>& parts, const std::string& initial_motion) {
+        if (initial_motion != "rest" && initial_motion != "estimated")
+          throw nb::value_error(("softrne: initial_motion must be 'rest' or 'estimated', not '" + initial_motion + "'").c_str());
+        try {
+          softrne::io::Dataset d = softrne::io::stack_recordings(parts);
+          if (initial_motion == "estimated") softrne::io::estimate_initial_rates(d);
+          return d;
+        } catch (const std::invalid_argument& e) {
+          throw nb::value_error(e.what());
+        }
+      },
+      "parts"_a, "initial_motion"_a,
+      "Several recordings as one data set (io::stack_recordings), each simulated from its own first "
+      "sample; 'estimated': at the angle rates of its first 9 samples.");
+  m.def(
       "_fit",
       [](const Robot& r, const softrne::io::Dataset& train, const softrne::io::Dataset* test, bool pressure_gain,
-         unsigned seed, int threads) {
+         unsigned seed, int threads, const std::string& fit_to, bool frame_per_recording) {
         softrne::fit::ArmFitOptions opt;
         opt.pressure_gain = pressure_gain;
         opt.optimiser.seed = seed;
         opt.optimiser.threads = std::max(1, threads);
+        opt.capture_frame_per_recording = frame_per_recording;
+        if (fit_to != "all" && fit_to != "angles" && fit_to != "markers")
+          throw nb::value_error(("softrne.fit: fit_to must be 'all', 'angles' or 'markers', not '" + fit_to + "'").c_str());
         const nlohmann::ordered_json report = run_interruptible([&](const std::atomic<bool>& stop) {
           opt.simulation.cvode.stop = &stop;
-          return softrne::cli::fit_report_json(softrne::cli::run_fit(r.desc, train, test, opt));
+          nlohmann::ordered_json j = softrne::cli::fit_report_json(softrne::cli::run_fit(r.desc, train, test, opt, fit_to));
+          softrne::cli::add_recordings(j, train, test);
+          return j;
         });
         return to_python(report);
       },
-      "robot"_a, "train"_a, "test"_a.none(), "pressure_gain"_a, "seed"_a, "threads"_a);
+      "robot"_a, "train"_a, "test"_a.none(), "pressure_gain"_a, "seed"_a, "threads"_a, "fit_to"_a,
+      "frame_per_recording"_a);
   m.def(
       "_loop",
       [](const Robot& r, const softrne::io::Dataset& train, const softrne::io::Dataset& test, int threads,
@@ -821,7 +844,10 @@ NB_MODULE(_softrne, m) {
             throw softrne::cli::Failure(e.what());
           }
         });
-        return to_python(softrne::cli::loop_report_json(res, true, opt));
+        nlohmann::ordered_json report = softrne::cli::loop_report_json(res, true, opt);
+        const std::vector<softrne::cli::RecordingMedians> medians = softrne::cli::loop_test_medians(res, test, opt);
+        softrne::cli::add_recordings(report, train, &test, &medians);
+        return to_python(report);
       },
       "robot"_a, "train"_a, "test"_a, "threads"_a, "max_effects"_a, "log"_a.none());
 }

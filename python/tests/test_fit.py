@@ -56,6 +56,29 @@ def test_fit_takes_datasets(robot, short_files):
     assert "test" not in a
 
 
+def test_fit_takes_several_recordings_as_softrne_fit_does(robot, train_data, tmp_path):
+    """A list of recordings with initial_motion='estimated': the same report as softrne-fit with
+    the option repeated (the 'recordings' key included), one entry per file."""
+    paths = []
+    for k, (a, b) in enumerate(((0, 150), (150, 300))):
+        paths.append(tmp_path / f"part{k}.csv")
+        t = train_data.t[a:b] - train_data.t[a]
+        softrne.write_dataset(paths[-1], robot, t, train_data.pressures[a:b], train_data.angles[a:b])
+    report_path = tmp_path / "report.json"
+    p = run([tool("SOFTRNE_FIT"), "--robot", str(ARM / "robot.json"), "--data", str(paths[0]), "--data",
+             str(paths[1]), "--initial-motion", "estimated", "--out", str(tmp_path / "fitted.json"),
+             "--report", str(report_path), "--quiet"])
+    assert p.returncode == 0, p.stderr
+    expected = json.loads(report_path.read_text())
+    report = softrne.fit(robot, [str(x) for x in paths], initial_motion="estimated")
+    assert without_timing(report) == without_timing(expected)
+    rec = report["recordings"]["train"]
+    assert [r["rows"] for r in rec] == [150, 150] and rec[1]["first_row"] == 150
+    assert all(len(r["initial_rates"]) == robot.nq for r in rec)
+    with pytest.raises(ValueError, match="initial_motion"):
+        softrne.fit(robot, [str(x) for x in paths], initial_motion="moving")
+
+
 def test_fit_needs_angles(robot, test_data):
     no_angles = softrne.Dataset(robot, test_data.t[:50], test_data.pressures[:50], None, source="mine")
     with pytest.raises(softrne.SimulationError, match="^mine: the data set has no measured angles"):

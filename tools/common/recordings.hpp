@@ -2,7 +2,8 @@
 /// \file
 /// \brief Data options that name several recordings (`--data a.csv --data b.csv`) and say how
 /// each starts (`--initial-motion rest|estimated`), for softrne-fit and softrne-loop
-/// (docs/formats.md section 6), and what the reports say about them.
+/// (docs/formats.md section 6), and what the reports say about them (the tools' and the
+/// Python package's).
 
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 
 #include "common/cli.hpp"
 #include "common/outputs.hpp"
+#include "softrne/fit/loop.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/recordings.hpp"
 #include "softrne/signals/error_stats.hpp"
@@ -88,7 +90,7 @@ inline nlohmann::ordered_json recordings_json(const io::Dataset& data) {
 }
 
 /// \brief Median absolute error of each recording of `data` for simulated angles `sim`
-/// (stacked as data's rows), as "file: 0.0123 rad" lines; empty for a single recording.
+/// (stacked as data's rows); empty for a single recording.
 inline std::vector<std::pair<std::string, double>> recording_medians(const io::Dataset& data,
                                                                      const Eigen::MatrixXd& sim,
                                                                      const std::vector<std::string>& names) {
@@ -100,6 +102,45 @@ inline std::vector<std::pair<std::string, double>> recording_medians(const io::D
     out.emplace_back(r.source, s.total.median);
   }
   return out;
+}
+
+/// \brief Each test recording's median angle error with the loop's baseline and final models.
+struct RecordingMedians {
+  std::string source;
+  double baseline = 0, final = 0;  ///< rad
+};
+
+/// \brief The loop's baseline and final models simulated on each recording of `test` (several
+/// recordings; empty otherwise).
+inline std::vector<RecordingMedians> loop_test_medians(const fit::LoopResult& r, const io::Dataset& test,
+                                                       const fit::LoopOptions& opt) {
+  std::vector<RecordingMedians> out;
+  if (test.recordings.size() < 2) return out;
+  const auto before = fit::simulate_dataset(r.baseline.fitted, test, opt.fit.simulation);
+  const auto after = fit::simulate_dataset(r.final_fit.fitted, test, opt.fit.simulation);
+  if (!before.ok() || !after.ok()) return out;
+  const auto& names = r.final_fit.fitted.coordinate_names;
+  const auto b = recording_medians(test, before.angles, names), a = recording_medians(test, after.angles, names);
+  for (std::size_t k = 0; k < b.size() && k < a.size(); ++k) out.push_back({b[k].first, b[k].second, a[k].second});
+  return out;
+}
+
+/// \brief Adds the reports' `recordings` key (docs/formats.md section 6) where a data set has a
+/// list of recordings (several files, or initial rates): `train` and `test` (recordings_json)
+/// and, for the loop, `test_medians`. One file started at rest adds nothing.
+inline void add_recordings(nlohmann::ordered_json& report, const io::Dataset& train, const io::Dataset* test,
+                           const std::vector<RecordingMedians>* medians = nullptr) {
+  if (train.recordings.empty() && (!test || test->recordings.empty())) return;
+  nlohmann::ordered_json rec;
+  rec["train"] = recordings_json(train);
+  rec["test"] = test ? recordings_json(*test) : nlohmann::ordered_json(nullptr);
+  if (medians) {
+    nlohmann::ordered_json per = nlohmann::ordered_json::array();
+    for (const auto& m : *medians)
+      per.push_back({{"source", m.source}, {"baseline_median", m.baseline}, {"final_median", m.final}});
+    rec["test_medians"] = per;
+  }
+  report["recordings"] = rec;
 }
 
 }  // namespace softrne::cli
