@@ -36,7 +36,9 @@ inline std::vector<int> marker_segments(const ArmDescription& d) {
   return out;
 }
 
-/// \brief The arm's reach: the sum of its CC joints' arc lengths and its links' lengths, m.
+/// \brief The arm's reach: the sum of its CC joints' arc lengths and its links' lengths.
+/// \param[in] d The arm.
+/// \return The reach, m.
 inline double arm_reach(const ArmDescription& d) {
   double L = 0;
   for (const auto& seg : d.spec.segments) {
@@ -77,7 +79,9 @@ struct CaptureFrame {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  ///< rotation (base axes in capture coordinates)
   Eigen::Vector3d t = Eigen::Vector3d::Zero();      ///< the base origin in capture coordinates, m
 
-  /// \brief Maps N x 3M base-frame positions into the capture frame.
+  /// \brief Maps base-frame positions into the capture frame.
+  /// \param[in] base N x 3M positions (x, y, z of each marker), base frame, m.
+  /// \return The same positions in the capture frame.
   Eigen::MatrixXd apply(const Eigen::MatrixXd& base) const {
     Eigen::MatrixXd y(base.rows(), base.cols());
     for (Eigen::Index i = 0; i < base.rows(); ++i)

@@ -105,8 +105,8 @@ struct ArmFitResult {
   /// simulated and measured positions, in mm.
   std::vector<CaptureFrame> capture_frames;  ///< one (shared) or one per recording
   std::vector<Eigen::VectorXd> capture_frame_std_errors;  ///< 6 per frame
-  Eigen::MatrixXd markers;
-  signals::ErrorStats marker_stats;
+  Eigen::MatrixXd markers;          ///< simulated markers in the capture frames (N x 3M), m
+  signals::ErrorStats marker_stats;  ///< per marker, simulated vs measured distance, mm
   int simulations = 0;      ///< simulations run by the fit
   double wall_seconds = 0;  ///< wall-clock time of the fit
 };
@@ -434,6 +434,12 @@ inline std::vector<Eigen::VectorXd> capture_frame_std_errors(
 /// in the frame fitted on the training data when the frame is shared, in its own recordings'
 /// frames (fitted to them: 6 numbers each, the physics untouched) when each recording has its
 /// own.
+/// \param[in] d The arm (with markers).
+/// \param[in] data The data set (with marker columns).
+/// \param[in] opt The integrator settings.
+/// \param[in] per_recording One frame per recording instead of one shared.
+/// \param[in] frames The frames to measure in (one shared), or null to fit them.
+/// \param[out] fitted The frames used, if not null.
 /// \return The statistics; empty if the simulation failed or the data have no markers.
 inline signals::ErrorStats marker_errors(const ArmDescription& d, const io::Dataset& data,
                                          const sim::ArmSimulationOptions& opt, bool per_recording,

@@ -323,6 +323,12 @@ SOFTRNE_SIM_INLINE ArmSimulation simulate_arm(const ArmDescription& desc, const 
 #endif
 
 /// \brief simulate_arm() from rest at the measured configuration q0 (size nq; zero if empty).
+/// \param[in] desc The arm.
+/// \param[in] t The N output (and input sample) times, s.
+/// \param[in] pressures N x num_inputs recorded pressures, Pa.
+/// \param[in] q0 The measured angles at t(0) (size nq), or empty for zero.
+/// \param[in] opt Integrator, interpolation and Jacobian settings.
+/// \return As the overload with initial rates.
 inline ArmSimulation simulate_arm(const ArmDescription& desc, const Eigen::VectorXd& t,
                                   const Eigen::MatrixXd& pressures, const Eigen::VectorXd& q0,
                                   const ArmSimulationOptions& opt = {}) {
