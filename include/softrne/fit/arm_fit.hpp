@@ -234,16 +234,8 @@ SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d, 
     const Eigen::VectorXd t = data.t.segment(r.first_row, r.rows).array() - r.time_shift;
     sim::ArmSimulation s = sim::simulate_arm(d, t, data.pressures.middleRows(r.first_row, r.rows),
                                              first_angles(r.first_row), r.initial_rates, o);
-    sim::SimulationStats& st = out.result.stats;
-    const sim::SimulationStats& rs = s.result.stats;
-    st.steps += rs.steps;
-    st.rhs_evals += rs.rhs_evals;
-    st.jac_evals += rs.jac_evals;
-    st.rhs_evals_for_jacobian_fd += rs.rhs_evals_for_jacobian_fd;
-    st.error_test_failures += rs.error_test_failures;
-    st.nonlinear_convergence_failures += rs.nonlinear_convergence_failures;
-    st.restarts += rs.restarts + 1;  // each recording starts afresh
-    st.wall_seconds += rs.wall_seconds;
+    out.result.stats += s.result.stats;
+    out.result.stats.restarts += 1;  // each recording starts afresh
     const Eigen::Index done = s.states.rows();
     out.states.middleRows(r.first_row, done) = s.states;
     out.angles.middleRows(r.first_row, done) = s.angles;

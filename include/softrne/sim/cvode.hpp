@@ -93,6 +93,21 @@ struct SimulationStats {
   long nonlinear_convergence_failures = 0;  ///< Newton convergence failures
   long restarts = 0;                        ///< re-initialisations at breakpoints
   double wall_seconds = 0;                  ///< wall-clock time of the whole call
+
+  /// \brief Adds another run's counters (several integrations reported as one).
+  /// \param[in] o The other run's statistics.
+  /// \return This.
+  SimulationStats& operator+=(const SimulationStats& o) {
+    steps += o.steps;
+    rhs_evals += o.rhs_evals;
+    jac_evals += o.jac_evals;
+    rhs_evals_for_jacobian_fd += o.rhs_evals_for_jacobian_fd;
+    error_test_failures += o.error_test_failures;
+    nonlinear_convergence_failures += o.nonlinear_convergence_failures;
+    restarts += o.restarts;
+    wall_seconds += o.wall_seconds;
+    return *this;
+  }
 };
 
 /// \brief Output of integrate().
@@ -303,19 +318,14 @@ inline std::string format_time(double t) {
 
 /// Adds CVODE's counters (reset by CVodeReInit) to `total`.
 inline void harvest_stats(void* mem, SimulationStats& total) {
-  long steps = 0, rhs = 0, jac = 0, rhs_fd = 0, etf = 0, ncf = 0;
-  CVodeGetNumSteps(mem, &steps);
-  CVodeGetNumRhsEvals(mem, &rhs);
-  CVodeGetNumJacEvals(mem, &jac);
-  CVodeGetNumLinRhsEvals(mem, &rhs_fd);
-  CVodeGetNumErrTestFails(mem, &etf);
-  CVodeGetNumNonlinSolvConvFails(mem, &ncf);
-  total.steps += steps;
-  total.rhs_evals += rhs;
-  total.jac_evals += jac;
-  total.rhs_evals_for_jacobian_fd += rhs_fd;
-  total.error_test_failures += etf;
-  total.nonlinear_convergence_failures += ncf;
+  SimulationStats run;
+  CVodeGetNumSteps(mem, &run.steps);
+  CVodeGetNumRhsEvals(mem, &run.rhs_evals);
+  CVodeGetNumJacEvals(mem, &run.jac_evals);
+  CVodeGetNumLinRhsEvals(mem, &run.rhs_evals_for_jacobian_fd);
+  CVodeGetNumErrTestFails(mem, &run.error_test_failures);
+  CVodeGetNumNonlinSolvConvFails(mem, &run.nonlinear_convergence_failures);
+  total += run;
 }
 
 inline long current_steps(void* mem) {
