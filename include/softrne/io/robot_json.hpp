@@ -140,13 +140,6 @@ inline EffectSpec read_effect(const nlohmann::json& v, std::size_t index, const 
   return e;
 }
 
-/// "markers[0] 'tip'".
-inline std::string marker_where(const std::string& prefix, std::size_t index, const std::string& name) {
-  std::string w = prefix + "markers[" + std::to_string(index) + "]";
-  if (!name.empty()) w += " '" + one_line(name) + "'";
-  return w;
-}
-
 inline MarkerSpec read_marker(const nlohmann::json& v, std::size_t index, const std::string& source,
                               const std::string& prefix) {
   const std::string where0 = marker_where(prefix, index, "");

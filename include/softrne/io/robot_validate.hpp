@@ -26,20 +26,31 @@ inline constexpr double kAxisUnitTolerance = 1e-6;
 
 namespace detail {
 
-/// \brief "segments[2] 'joint2'" (with an optional prefix such as "fitted_robot.").
-inline std::string segment_where(const std::string& prefix, std::size_t index,
-                                 const std::string& name) {
-  std::string w = prefix + "segments[" + std::to_string(index) + "]";
+/// \brief "<list>[<index>] '<name>'" (with an optional prefix such as "fitted_robot."; no
+/// name part for an empty name): where an item of a list of the description is.
+inline std::string item_where(const std::string& prefix, const char* list, std::size_t index,
+                              const std::string& name) {
+  std::string w = prefix + list + "[" + std::to_string(index) + "]";
   if (!name.empty()) w += " '" + one_line(name) + "'";
   return w;
 }
 
-/// \brief "effects[0] 'stiffening'".
+/// \brief "segments[2] 'joint2'" (item_where()).
+inline std::string segment_where(const std::string& prefix, std::size_t index,
+                                 const std::string& name) {
+  return item_where(prefix, "segments", index, name);
+}
+
+/// \brief "effects[0] 'stiffening'" (item_where()).
 inline std::string effect_where(const std::string& prefix, std::size_t index,
                                 const std::string& name) {
-  std::string w = prefix + "effects[" + std::to_string(index) + "]";
-  if (!name.empty()) w += " '" + one_line(name) + "'";
-  return w;
+  return item_where(prefix, "effects", index, name);
+}
+
+/// \brief "markers[0] 'tip'" (item_where()).
+inline std::string marker_where(const std::string& prefix, std::size_t index,
+                                const std::string& name) {
+  return item_where(prefix, "markers", index, name);
 }
 
 /// \brief Checks of one number of the description.
@@ -213,8 +224,7 @@ inline void validate_robot_global(const RobotSpec& robot, const std::string& sou
   std::set<std::string> marker_names;
   for (std::size_t k = 0; k < robot.markers.size(); ++k) {
     const MarkerSpec& m = robot.markers[k];
-    std::string where = prefix + "markers[" + std::to_string(k) + "]";
-    if (!m.name.empty()) where += " '" + one_line(m.name) + "'";
+    const std::string where = marker_where(prefix, k, m.name);
     const bool identifier =
         !m.name.empty() && std::isalpha(static_cast<unsigned char>(m.name[0])) &&
         std::all_of(m.name.begin(), m.name.end(),
