@@ -101,15 +101,29 @@ struct FitRun {
   std::vector<Eigen::VectorXd> frame_std_errors;  ///< empty where the objective did not hold the markers
 };
 
-/// \brief Error statistics of model `d` simulated on `data`; cli::Failure naming the data set
-/// if it does not simulate (`which`: "starting", "fitted").
-inline signals::ErrorStats simulated_errors(const ArmDescription& d, const io::Dataset& data,
-                                            const sim::ArmSimulationOptions& opt,
-                                            const std::string& which) {
+/// \brief Model `d` on `data`, simulated once: its angle errors (rad) if `angles` is asked for,
+/// its marker errors (mm, fit::marker_errors: in `frames`, or in frames fitted in closed form
+/// and returned in `fitted`) if `markers` is asked for.
+struct Measured {
+  signals::ErrorStats angles, markers;
+};
+/// \brief Measures `d` on `data` (Measured); cli::Failure naming the data set if the angles are
+/// asked for and it does not simulate (`which`: "starting", "fitted"). Nothing asked: no
+/// simulation.
+inline Measured measure(const ArmDescription& d, const io::Dataset& data, const sim::ArmSimulationOptions& opt,
+                        const std::string& which, bool angles, bool markers, bool per_recording = false,
+                        const std::vector<CaptureFrame>* frames = nullptr,
+                        std::vector<CaptureFrame>* fitted = nullptr) {
+  Measured m;
+  if (!angles && !markers) return m;
   const auto s = fit::simulate_dataset(d, data, opt);
-  if (!s.ok())
-    throw Failure(data.source + ": the " + which + " model fails to simulate: " + s.result.message);
-  return signals::error_stats(s.angles, data.angles, d.coordinate_names);
+  if (angles) {
+    if (!s.ok())
+      throw Failure(data.source + ": the " + which + " model fails to simulate: " + s.result.message);
+    m.angles = signals::error_stats(s.angles, data.angles, d.coordinate_names);
+  }
+  if (markers) m.markers = fit::marker_errors(d, data, s, per_recording, frames, fitted);
+  return m;
 }
 
 /// \brief Fits `desc` to `train` (fit::fit_arm) and measures it before and after, on `train`
@@ -140,7 +154,13 @@ inline FitRun run_fit(const ArmDescription& desc, const io::Dataset& train, cons
       objective.recordings.push_back(r);
     }
   }
-  if (run.has_angles) run.train_before = simulated_errors(desc, train, opt.simulation, "starting");
+  // Each model on each data set is simulated once, for its angle and its marker errors.
+  const bool per = run.frame_per_recording = run.has_markers && opt.capture_frame_per_recording;
+  std::vector<CaptureFrame> start_frames;
+  const Measured train_before = measure(desc, train, opt.simulation, "starting", run.has_angles, run.has_markers,
+                                        per, nullptr, &start_frames);
+  run.train_before = train_before.angles;
+  run.markers_train_before = train_before.markers;
   try {
     run.result = fit::fit_arm(desc, objective, opt);
   } catch (const std::invalid_argument& e) {
@@ -149,30 +169,27 @@ inline FitRun run_fit(const ArmDescription& desc, const io::Dataset& train, cons
   if (!std::isfinite(run.result.fit.cost))
     throw Failure(train.source + ": the fit found no parameters that simulate: " + run.result.fit.message);
   const ArmDescription& fitted = run.result.fitted;
-  if (run.has_angles)
-    run.train_after = objective.has_angles ? run.result.stats : simulated_errors(fitted, train, opt.simulation, "fitted");
+  // What the objective held is measured already (the fit's own statistics and frames).
+  const bool fitted_markers = run.has_markers && objective.has_markers;
+  const Measured train_after = measure(fitted, train, opt.simulation, "fitted", run.has_angles && !objective.has_angles,
+                                       run.has_markers && !fitted_markers, per, nullptr, &run.frames);
+  if (run.has_angles) run.train_after = objective.has_angles ? run.result.stats : train_after.angles;
+  if (fitted_markers) {
+    run.frames = run.result.capture_frames;
+    run.frame_std_errors = run.result.capture_frame_std_errors;
+    run.markers_train_after = run.result.marker_stats;
+  } else if (run.has_markers) {
+    run.markers_train_after = train_after.markers;
+  }
   if (test) {
     run.has_test = true;
-    if (test->has_angles) {
-      run.test_before = simulated_errors(desc, *test, opt.simulation, "starting");
-      run.test_after = simulated_errors(fitted, *test, opt.simulation, "fitted");
-    }
-  }
-  if (run.has_markers) {
-    const bool per = run.frame_per_recording = opt.capture_frame_per_recording;
-    std::vector<CaptureFrame> start_frames;
-    run.markers_train_before = fit::marker_errors(desc, train, opt.simulation, per, nullptr, &start_frames);
-    if (objective.has_markers) {
-      run.frames = run.result.capture_frames;
-      run.frame_std_errors = run.result.capture_frame_std_errors;
-      run.markers_train_after = run.result.marker_stats;
-    } else {
-      run.markers_train_after = fit::marker_errors(fitted, train, opt.simulation, per, nullptr, &run.frames);
-    }
-    if (test && test->has_markers) {
-      run.markers_test_before = fit::marker_errors(desc, *test, opt.simulation, per, &start_frames);
-      run.markers_test_after = fit::marker_errors(fitted, *test, opt.simulation, per, &run.frames);
-    }
+    const bool markers = run.has_markers && test->has_markers;
+    const Measured before = measure(desc, *test, opt.simulation, "starting", test->has_angles, markers, per, &start_frames);
+    const Measured after = measure(fitted, *test, opt.simulation, "fitted", test->has_angles, markers, per, &run.frames);
+    run.test_before = before.angles;
+    run.test_after = after.angles;
+    run.markers_test_before = before.markers;
+    run.markers_test_after = after.markers;
   }
   return run;
 }

@@ -420,25 +420,23 @@ inline std::vector<Eigen::VectorXd> capture_frame_std_errors(
 }  // namespace detail
 
 /// \brief The marker errors (per marker the distance between simulated and measured positions,
-/// mm) of model `d` simulated on `data` (with markers), in capture frames `frames` (one shared,
-/// or one per recording as `per_recording` says) or, if null, in the frames fitted in closed
-/// form to this simulation (returned in `fitted` if given). A held-out data set is measured
-/// in the frame fitted on the training data when the frame is shared, in its own recordings'
-/// frames (fitted to them: 6 numbers each, the physics untouched) when each recording has its
-/// own.
+/// mm) of model `d` simulated on `data` (with markers; `s` = simulate_dataset(d, data, ...)),
+/// in capture frames `frames` (one shared, or one per recording as `per_recording` says) or,
+/// if null, in the frames fitted in closed form to this simulation (returned in `fitted` if
+/// given). A held-out data set is measured in the frame fitted on the training data when the
+/// frame is shared, in its own recordings' frames (fitted to them: 6 numbers each, the physics
+/// untouched) when each recording has its own.
 /// \param[in] d The arm (with markers).
 /// \param[in] data The data set (with marker columns).
-/// \param[in] opt The integrator settings.
+/// \param[in] s The arm simulated on the data set.
 /// \param[in] per_recording One frame per recording instead of one shared.
 /// \param[in] frames The frames to measure in (one shared), or null to fit them.
 /// \param[out] fitted The frames used, if not null.
 /// \return The statistics; empty if the simulation failed or the data have no markers.
-inline signals::ErrorStats marker_errors(const ArmDescription& d, const io::Dataset& data,
-                                         const sim::ArmSimulationOptions& opt, bool per_recording,
-                                         const std::vector<CaptureFrame>* frames,
+inline signals::ErrorStats marker_errors(const ArmDescription& d, const io::Dataset& data, const sim::ArmSimulation& s,
+                                         bool per_recording, const std::vector<CaptureFrame>* frames,
                                          std::vector<CaptureFrame>* fitted = nullptr) {
   if (!data.has_markers || d.spec.markers.empty()) return {};
-  const sim::ArmSimulation s = simulate_dataset(d, data, opt);
   if (!s.ok() || s.states.rows() != data.t.size()) return {};
   const Eigen::MatrixXd base = marker_positions(d, s.states);
   const std::vector<int> group = detail::frame_of_rows(data, per_recording);
