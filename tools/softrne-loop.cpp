@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
     if (!plots_dir.empty()) write_plot_data(plots_dir, r, train, test, opt);
     nlohmann::ordered_json report = cli::loop_report_json(r, true, opt);
     // Per held-out recording, the median error before and after (several test recordings).
-    const std::vector<cli::RecordingMedians> medians = cli::loop_test_medians(r, test, opt);
+    const std::vector<cli::RecordingMedians> medians = cli::loop_test_medians(r, test);
     cli::add_recordings(report, train, &test, &medians);
     io::detail::write_text_file(out_path, report.dump(2) + "\n");
     std::printf("closed loop in %.1f s (%d simulations)\n", r.wall_seconds, r.simulations);

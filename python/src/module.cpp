@@ -845,7 +845,7 @@ NB_MODULE(_softrne, m) {
           }
         });
         nlohmann::ordered_json report = softrne::cli::loop_report_json(res, true, opt);
-        const std::vector<softrne::cli::RecordingMedians> medians = softrne::cli::loop_test_medians(res, test, opt);
+        const std::vector<softrne::cli::RecordingMedians> medians = softrne::cli::loop_test_medians(res, test);
         softrne::cli::add_recordings(report, train, &test, &medians);
         return to_python(report);
       },

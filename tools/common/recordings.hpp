@@ -110,17 +110,13 @@ struct RecordingMedians {
   double baseline = 0, final = 0;  ///< rad
 };
 
-/// \brief The loop's baseline and final models simulated on each recording of `test` (several
-/// recordings; empty otherwise).
-inline std::vector<RecordingMedians> loop_test_medians(const fit::LoopResult& r, const io::Dataset& test,
-                                                       const fit::LoopOptions& opt) {
+/// \brief Each recording's median error of the loop's baseline and final models on `test` (from
+/// their simulations that run_loop kept; several recordings, empty otherwise).
+inline std::vector<RecordingMedians> loop_test_medians(const fit::LoopResult& r, const io::Dataset& test) {
   std::vector<RecordingMedians> out;
-  if (test.recordings.size() < 2) return out;
-  const auto before = fit::simulate_dataset(r.baseline.fitted, test, opt.fit.simulation);
-  const auto after = fit::simulate_dataset(r.final_fit.fitted, test, opt.fit.simulation);
-  if (!before.ok() || !after.ok()) return out;
   const auto& names = r.final_fit.fitted.coordinate_names;
-  const auto b = recording_medians(test, before.angles, names), a = recording_medians(test, after.angles, names);
+  const auto b = recording_medians(test, r.baseline_test_angles, names);
+  const auto a = recording_medians(test, r.final_test_angles, names);
   for (std::size_t k = 0; k < b.size() && k < a.size(); ++k) out.push_back({b[k].first, b[k].second, a[k].second});
   return out;
 }

@@ -140,6 +140,8 @@ struct LoopResult {
   /// \brief The final model's errors on the training set.
   /// \var final_test
   /// \brief The final model's errors on the test set (empty without one).
+  Eigen::MatrixXd baseline_test_angles;  ///< the baseline simulated on the test set (empty without one or on failure)
+  Eigen::MatrixXd final_test_angles;     ///< the final model simulated on the test set (likewise)
   std::vector<std::vector<CandidateScore>> rounds;  ///< candidates of each round, best first
   std::vector<AddedEffect> added;  ///< the effects kept, in the order they were added
 
@@ -411,7 +413,10 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   out.simulations += out.baseline.simulations;
   if (test) {
     const sim::ArmSimulation s = simulate_dataset(out.baseline.fitted, *test, sim_opt);
-    if (s.ok()) out.baseline_test = signals::error_stats(s.angles, test->angles, out.baseline.fitted.coordinate_names);
+    if (s.ok()) {
+      out.baseline_test = signals::error_stats(s.angles, test->angles, out.baseline.fitted.coordinate_names);
+      out.baseline_test_angles = s.angles;
+    }
   }
 
   // Fold base models, each fitted from the declared model on its own training blocks.
@@ -872,8 +877,10 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
   if (current_fit.angles.size()) out.final_residual = train.angles - current_fit.angles;
   const sim::ArmSimulation final_test_sim =
       test ? simulate_dataset(current, *test, sim_opt) : sim::ArmSimulation();
-  if (test && final_test_sim.ok())
+  if (test && final_test_sim.ok()) {
     out.final_test = signals::error_stats(final_test_sim.angles, test->angles, current.coordinate_names);
+    out.final_test_angles = final_test_sim.angles;
+  }
   if (out.final_residual.size())
     out.unexplained_train = analyse_residual(current, train.t, train.angles, train.angles - out.final_residual,
                                              train.pressures, out.noise_sigma, opt.unexplained_ratio);
