@@ -43,4 +43,11 @@ if ! "$py" -c 'import numpy, nanobind, pytest' >/dev/null 2>&1; then
     exit 1
   fi
 fi
+# Pinocchio (pip `pin`, ~80 MB of wheels) for the cross-check tests/pinocchio runs with this
+# Python (ctest pinocchio.python_check): optional, so a failure here only leaves that test out.
+if [[ "${SOFTRNE_PINOCCHIO:-1}" != 0 ]] && ! "$py" -c 'import pinocchio' >/dev/null 2>&1; then
+  log "pip install pin  (Pinocchio, for the cross-check; SOFTRNE_PINOCCHIO=0 skips it)"
+  "$py" -m pip install --disable-pip-version-check --no-input -q pin >&2 \
+    || log "pip install pin failed: the Pinocchio cross-check is left out"
+fi
 echo "$(cd "$venv" && pwd)/bin/python"
