@@ -3,12 +3,15 @@
 The compiled core of the softrne C++ library (module ``softrne._softrne``, built with
 nanobind): constant-curvature pneumatic joints, rigid links and revolute joints in any order,
 inverse and forward dynamics by the recursive Newton-Euler algorithm, simulation of recorded
-chamber pressures with CVODE, and the fits and closed loop of the command-line tools.
+chamber pressures with CVODE, linearisation and simulation under a controller in the loop,
+and the fits and closed loop of the command-line tools.
 
     >>> import softrne
     >>> robot = softrne.Robot.from_json("examples/data/arm-a-1/robot.json")
     >>> tau = robot.rnea(q, qd, qdd)            # (nq,) or batched (N, nq)
     >>> angles = softrne.simulate(robot, t, pressures, q0)
+    >>> lin = robot.linearise(x, p)             # A, B, f; lin.discretise_zoh(h) -> Ad, Bd, cd
+    >>> run = softrne.simulate_closed_loop(robot, controller, t_end, control_period)
 
 See docs/python.md.
 """
@@ -19,25 +22,37 @@ import os
 from typing import Any, Callable, Optional, Sequence, Union
 
 from ._softrne import (
+    ClosedLoopSimulation,
+    ControllerInput,
     Dataset,
+    DiscreteLinearisation,
     InputError,
+    Linearisation,
     Robot,
     SimulationError,
+    discretise_zoh,
     read_dataset,
     simulate,
+    simulate_closed_loop,
     write_dataset,
 )
 from . import _softrne
 
 __all__ = [
+    "ClosedLoopSimulation",
+    "ControllerInput",
     "Dataset",
+    "DiscreteLinearisation",
     "InputError",
+    "Linearisation",
     "Robot",
     "SimulationError",
+    "discretise_zoh",
     "fit",
     "loop",
     "read_dataset",
     "simulate",
+    "simulate_closed_loop",
     "write_dataset",
 ]
 

@@ -16,7 +16,9 @@
 #include <optional>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -40,7 +42,10 @@
 #include "softrne/fit/parallel_for.hpp"
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
+#include "softrne/sim/arm_jacobian.hpp"
 #include "softrne/sim/arm_simulation.hpp"
+#include "softrne/sim/closed_loop.hpp"
+#include "softrne/sim/linearisation.hpp"
 #include "softrne/softrne.hpp"
 
 namespace nb = nanobind;
@@ -91,6 +96,11 @@ class NDArray : public nb::object {
   NB_OBJECT_DEFAULT(NDArray, nb::object, "numpy.typing.NDArray[numpy.float64]", is_ndarray)
 };
 using OutArray = NDArray;
+/// \brief A controller argument (simulate_closed_loop checks that it is callable).
+class ControllerFunction : public nb::object {
+  NB_OBJECT_DEFAULT(ControllerFunction, nb::object,
+                    "collections.abc.Callable[[ControllerInput], numpy.typing.ArrayLike]", any_object)
+};
 
 /// \brief An argument as a C-contiguous float64 numpy array: the argument itself where it is
 /// one (read through the numpy C API, no copy: a few ns), else a converted copy.
@@ -327,49 +337,55 @@ softrne::io::Dataset dataset_from_arrays(const Robot& r, const ArrayLike& t, con
 using PI = softrne::sim::ArmSimulationOptions::PressureInterpolation;
 using JM = softrne::sim::ArmSimulationOptions::JacobianMethod;
 
-double positive_number(nb::handle v, const std::string& key) {
+double positive_number(nb::handle v, const std::string& key, const char* fn = "simulate") {
   double x = 0;
   if (!nb::try_cast(v, x) || !(x > 0) || !std::isfinite(x))
-    throw nb::value_error(("softrne.simulate: " + key + " must be a positive number").c_str());
+    throw nb::value_error(("softrne." + std::string(fn) + ": " + key + " must be a positive number").c_str());
   return x;
 }
 
 /// The solver options of softrne-sim, by the names of its command-line options
-/// (atol_velocity for --atol-velocity).
-softrne::sim::ArmSimulationOptions simulation_options(const nb::kwargs& kw, double t0, double t1) {
+/// (atol_velocity for --atol-velocity), for the function `fn`. `held`: the pressures are held
+/// between samples (simulate_closed_loop), so interpolation and smooth do not apply.
+softrne::sim::ArmSimulationOptions simulation_options(const nb::kwargs& kw, double t0, double t1,
+                                                      const char* fn = "simulate", bool held = false) {
+  const std::string prefix = "softrne." + std::string(fn) + ": ";
   softrne::sim::ArmSimulationOptions opt;
   long max_steps = 0;
   double atol_velocity = 0;
   for (auto [k, v] : kw) {
     const std::string key = nb::cast<std::string>(k);
     if (key == "rtol") {
-      opt.cvode.rtol = positive_number(v, key);
+      opt.cvode.rtol = positive_number(v, key, fn);
     } else if (key == "atol") {
-      opt.cvode.atol = positive_number(v, key);
+      opt.cvode.atol = positive_number(v, key, fn);
     } else if (key == "atol_velocity") {
-      atol_velocity = positive_number(v, key);
+      atol_velocity = positive_number(v, key, fn);
     } else if (key == "smooth") {
-      opt.pressure_smoothing = positive_number(v, key);
+      opt.pressure_smoothing = positive_number(v, key, fn);
     } else if (key == "max_wall_seconds") {
-      opt.cvode.max_wall_seconds = positive_number(v, key);
+      opt.cvode.max_wall_seconds = positive_number(v, key, fn);
     } else if (key == "max_steps") {
       if (!nb::try_cast(v, max_steps) || max_steps < 1)
-        throw nb::value_error("softrne.simulate: max_steps must be a positive integer");
+        throw nb::value_error((prefix + "max_steps must be a positive integer").c_str());
+    } else if (held && (key == "interpolation" || key == "smooth")) {
+      throw nb::type_error((prefix + "solver option '" + key +
+                            "' does not apply: the pressures are held between samples")
+                               .c_str());
     } else if (key == "interpolation") {
       std::string m;
       if (!nb::try_cast(v, m) || (m != "pchip" && m != "linear" && m != "zoh"))
-        throw nb::value_error("softrne.simulate: interpolation must be 'pchip', 'linear' or 'zoh'");
+        throw nb::value_error((prefix + "interpolation must be 'pchip', 'linear' or 'zoh'").c_str());
       opt.interpolation = m == "pchip" ? PI::pchip : m == "linear" ? PI::linear : PI::zero_order_hold;
     } else if (key == "jacobian") {
       std::string m;
       if (!nb::try_cast(v, m) || (m != "ad" && m != "ad-forward" && m != "fd"))
-        throw nb::value_error("softrne.simulate: jacobian must be 'ad', 'ad-forward' or 'fd'");
+        throw nb::value_error((prefix + "jacobian must be 'ad', 'ad-forward' or 'fd'").c_str());
       opt.autodiff_jacobian = m != "fd";
       opt.jacobian_method = m == "ad-forward" ? JM::forward_dynamics : JM::inverse_dynamics;
     } else {
-      throw nb::type_error(("softrne.simulate: unknown solver option '" + key +
-                            "' (known: rtol, atol, atol_velocity, interpolation, smooth, jacobian, "
-                            "max_steps, max_wall_seconds)")
+      throw nb::type_error((prefix + "unknown solver option '" + key + "' (known: rtol, atol, atol_velocity, " +
+                            (held ? "" : "interpolation, smooth, ") + "jacobian, max_steps, max_wall_seconds)")
                                .c_str());
     }
   }
@@ -435,6 +451,89 @@ auto run_interruptible(F&& f) {
   }
   raise_if_interrupted();
   return std::move(*result);
+}
+
+// ---- linearisation and control in the loop -----------------------------------------------
+
+namespace sim = softrne::sim;
+
+/// A vector argument of the robot's size `size` (its `what`: "states", "pressures", ...):
+/// ValueError naming the function, the argument and both sizes otherwise.
+Eigen::VectorXd robot_vector(nb::handle h, const char* fn, const char* name, Eigen::Index size, const char* what) {
+  Array a = as_array(h, fn, name);
+  if (a.ndim() != 1 || static_cast<Eigen::Index>(a.shape(0)) != size)
+    throw nb::value_error((std::string("softrne.") + fn + ": " + name + " has shape " + shape_text(a) +
+                           "; the robot has " + std::to_string(size) + " " + what + ": expected (" +
+                           std::to_string(size) + ",)")
+                              .c_str());
+  return CVec(a.data(), size);
+}
+
+std::string number_text(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.9g", x);
+  return buf;
+}
+
+void check_sample_time(double h, const char* fn) {
+  if (!(h > 0) || !std::isfinite(h))
+    throw nb::value_error((std::string("softrne.") + fn + ": h must be positive and finite (got " + number_text(h) + ")")
+                              .c_str());
+}
+
+/// \brief What a Python controller receives at a sample (sim::ControllerInput as numpy
+/// arrays, new ones at every sample: the controller may keep them).
+struct ControllerObservation {
+  int k = 0;
+  double t = 0;
+  OutArray angles, velocities, state;
+};
+
+/// Raises (as a C++ nb::python_error) a Python exception of `type` with `message`.
+[[noreturn]] void raise_python(PyObject* type, const std::string& message) {
+  PyErr_SetString(type, message.c_str());
+  throw nb::python_error();
+}
+
+/// The pressures a Python controller returned at sample `in`: num_pressures finite numbers,
+/// else TypeError (None) or ValueError naming the sample and what was wrong. GIL held.
+Eigen::VectorXd controller_pressures(const Robot& r, nb::handle ret, const sim::ControllerInput& in) {
+  const int m = r.desc.num_inputs;
+  const std::string at = "softrne.simulate_closed_loop: the controller at t = " + number_text(in.t) + " s (sample " +
+                         std::to_string(in.k) + ") returned ";
+  const std::string expected = "; the robot has " + std::to_string(m) + " pressures: expected (" + std::to_string(m) + ",)";
+  if (ret.is_none()) raise_python(PyExc_TypeError, at + "None" + expected);
+  PyObject* c = PyArray_FROMANY(ret.ptr(), NPY_DOUBLE, 0, 0, NPY_ARRAY_IN_ARRAY);
+  if (!c) {
+    nb::python_error e;
+    raise_python(PyExc_ValueError, at + "something that is not an array of numbers (" +
+                                       std::string(nb::str(e.value()).c_str()) + ")" + expected);
+  }
+  nb::object keep = nb::steal(c);
+  auto* a = reinterpret_cast<PyArrayObject*>(c);
+  std::string shape = "(";
+  for (int i = 0; i < PyArray_NDIM(a); ++i) shape += (i ? ", " : "") + std::to_string(PyArray_DIM(a, i));
+  shape += PyArray_NDIM(a) == 1 ? ",)" : ")";
+  if (PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != m) raise_python(PyExc_ValueError, at + "shape " + shape + expected);
+  const Eigen::VectorXd p = CVec(static_cast<const double*>(PyArray_DATA(a)), m);
+  for (int i = 0; i < m; ++i)
+    if (!std::isfinite(p(i)))
+      raise_python(PyExc_ValueError, at + "a non-finite pressure (" + r.desc.pressure_names[static_cast<size_t>(i)] +
+                                         " = " + number_text(p(i)) + ")");
+  return p;
+}
+
+nb::dict stats_dict(const sim::SimulationStats& s) {
+  nb::dict d;
+  d["steps"] = s.steps;
+  d["rhs_evals"] = s.rhs_evals;
+  d["jac_evals"] = s.jac_evals;
+  d["rhs_evals_for_jacobian_fd"] = s.rhs_evals_for_jacobian_fd;
+  d["error_test_failures"] = s.error_test_failures;
+  d["nonlinear_convergence_failures"] = s.nonlinear_convergence_failures;
+  d["restarts"] = s.restarts;
+  d["wall_seconds"] = s.wall_seconds;
+  return d;
 }
 
 }  // namespace
@@ -689,6 +788,55 @@ NB_MODULE(_softrne, m) {
        kThreadsDoc)
           .c_str());
 
+
+  // ---- the state equation, its linearisation -----------------------------------------------
+  robot.def_prop_ro("num_states", [](const Robot& r) { return r.desc.num_states(); },
+                    "Number of states n of the simulated arm: x = [q (nq), qd (nq), the effects' internal "
+                    "states] (2 nq when the robot has no effect with states).");
+  robot.def(
+      "initial_state",
+      [](const Robot& r, const ArrayLike& q0, const ArrayLike& p0) {
+        const Eigen::VectorXd q =
+            q0.is_none() ? Eigen::VectorXd() : robot_vector(q0, "initial_state", "q0", r.desc.nq, "coordinates");
+        const Eigen::VectorXd p = p0.is_none() ? Eigen::VectorXd::Zero(r.desc.num_inputs)
+                                               : robot_vector(p0, "initial_state", "p0", r.desc.num_inputs, "pressures");
+        return vector_out(softrne::initial_state(r.desc, q, p));
+      },
+      "q0"_a = nb::none(), "p0"_a = nb::none(),
+      "The state (num_states,) a simulation starts from: at rest at the measured angles q0 (nq,) (the "
+      "measurement model inverted; None: q = 0), the effects' states at rest under the pressures p0 "
+      "(num_pressures,) (None: 0 Pa), as simulate and simulate_closed_loop start.");
+  robot.def(
+      "state_derivative",
+      [](const Robot& r, const ArrayLike& x, const ArrayLike& p) {
+        const Eigen::VectorXd xv = robot_vector(x, "state_derivative", "x", r.desc.num_states(), "states");
+        const Eigen::VectorXd pv = robot_vector(p, "state_derivative", "p", r.desc.num_inputs, "pressures");
+        sim::ArmJacobian f(r.desc);
+        Eigen::VectorXd xdot(xv.size());
+        f.rhs(xv, pv, xdot);
+        return vector_out(xdot);
+      },
+      "x"_a, "p"_a,
+      "The simulator's state equation f(x, p) = dx/dt (eq. 23 with the springs, dampers, pressures and "
+      "effects; sim::ArmJacobian::rhs) at the state x (num_states,) and the chamber pressures p "
+      "(num_pressures,), Pa. NaN where it is not defined (M not positive definite). A transport delay "
+      "(input_delay effect) is not part of f.");
+  robot.def(
+      "linearise",
+      [](const Robot& r, const ArrayLike& x, const ArrayLike& p) {
+        const Eigen::VectorXd xv = robot_vector(x, "linearise", "x", r.desc.num_states(), "states");
+        const Eigen::VectorXd pv = robot_vector(p, "linearise", "p", r.desc.num_inputs, "pressures");
+        try {
+          return sim::linearise(r.desc, xv, pv);
+        } catch (const std::invalid_argument& e) {
+          throw nb::value_error((std::string("softrne.") + e.what()).c_str());
+        }
+      },
+      "x"_a, "p"_a,
+      "The linearisation of the state equation at (x, p) (sim::linearise): A = df/dx (n, n) and B = "
+      "df/dp (n, num_pressures), exact (forward-mode AutoDiff), and f = f(x, p), so that near (x, p) "
+      "d(dx)/dt = f + A dx + B dp. Raises ValueError if f or its derivatives are not finite there.");
+
   // ---- data sets -------------------------------------------------------------------------
   nb::class_<softrne::io::Dataset>(m, "Dataset",
                                    "A data set (docs/formats.md section 2): time, chamber pressures and "
@@ -786,6 +934,199 @@ NB_MODULE(_softrne, m) {
       "'linear', 'zoh'), smooth (seconds of Gaussian pre-smoothing; off), jacobian ('ad', "
       "'ad-forward', 'fd'), max_steps (max(1e5, 1e4 per s)), max_wall_seconds. Raises "
       "SimulationError if the integration fails.");
+
+  // ---- linearisation and control in the loop ----------------------------------------------
+  nb::class_<sim::Linearisation>(m, "Linearisation",
+                                 "The continuous linearisation of x' = f(x, p) at (x, p) (Robot.linearise): "
+                                 "d(dx)/dt = f + A dx + B dp.")
+      .def_prop_ro("x", [](const sim::Linearisation& l) { return vector_out(l.x); }, "The state it was taken at, (n,).")
+      .def_prop_ro("p", [](const sim::Linearisation& l) { return vector_out(l.p); },
+                   "The pressures it was taken at, Pa, (num_pressures,).")
+      .def_prop_ro("f", [](const sim::Linearisation& l) { return vector_out(l.f); },
+                   "f(x, p), (n,): zero at an equilibrium.")
+      .def_prop_ro("A", [](const sim::Linearisation& l) { return matrix_out(l.A); }, "df/dx, (n, n).")
+      .def_prop_ro("B", [](const sim::Linearisation& l) { return matrix_out(l.B); },
+                   "df/dp, (n, num_pressures) (1/s per Pa in the velocity rows).")
+      .def(
+          "discretise_zoh",
+          [](const sim::Linearisation& l, double h) {
+            check_sample_time(h, "Linearisation.discretise_zoh");
+            return sim::discretise_zoh(l, h);
+          },
+          "h"_a,
+          "The zero-order-hold discretisation for the sample time h (s) (sim::discretise_zoh): dx_k+1 = "
+          "Ad dx_k + Bd dp_k + cd, from the exponential of [[A, B, f], [0, 0, 0]] h.")
+      .def("__repr__", [](const sim::Linearisation& l) {
+        return "softrne.Linearisation(n=" + std::to_string(l.A.rows()) + ", num_pressures=" + std::to_string(l.B.cols()) +
+               ", |f|=" + number_text(l.f.norm()) + ")";
+      });
+
+  nb::class_<sim::DiscreteLinearisation>(m, "DiscreteLinearisation",
+                                         "A zero-order-hold discretisation: dx_k+1 = Ad dx_k + Bd dp_k + cd over "
+                                         "a sample time h. Unpacks as Ad, Bd, cd = ...")
+      .def_ro("h", &sim::DiscreteLinearisation::h, "The sample time, s.")
+      .def_prop_ro("Ad", [](const sim::DiscreteLinearisation& d) { return matrix_out(d.Ad); }, "exp(A h), (n, n).")
+      .def_prop_ro("Bd", [](const sim::DiscreteLinearisation& d) { return matrix_out(d.Bd); },
+                   "The integral of exp(A s) ds over [0, h] times B, (n, m).")
+      .def_prop_ro("cd", [](const sim::DiscreteLinearisation& d) { return vector_out(d.cd); },
+                   "The integral of exp(A s) ds over [0, h] times f, (n,): the drift off an equilibrium "
+                   "(0 at one).")
+      .def("__iter__",
+           [](const sim::DiscreteLinearisation& d) {
+             return nb::iter(nb::make_tuple(matrix_out(d.Ad), matrix_out(d.Bd), vector_out(d.cd)));
+           })
+      .def("__repr__", [](const sim::DiscreteLinearisation& d) {
+        return "softrne.DiscreteLinearisation(h=" + number_text(d.h) + ", n=" + std::to_string(d.Ad.rows()) +
+               ", m=" + std::to_string(d.Bd.cols()) + ")";
+      });
+
+  m.def(
+      "discretise_zoh",
+      [](const ArrayLike& A, const ArrayLike& B, double h, const ArrayLike& f) {
+        const char* fn = "discretise_zoh";
+        const Array a = as_array(A, fn, "A");
+        if (a.ndim() != 2 || a.shape(0) != a.shape(1))
+          throw nb::value_error(("softrne.discretise_zoh: A has shape " + shape_text(a) + "; expected a square (n, n)").c_str());
+        const auto n = static_cast<Eigen::Index>(a.shape(0));
+        const Array b = as_array(B, fn, "B");
+        if (b.ndim() != 2 || static_cast<Eigen::Index>(b.shape(0)) != n)
+          throw nb::value_error(("softrne.discretise_zoh: B has shape " + shape_text(b) + "; A has " +
+                                 std::to_string(n) + " rows: expected (" + std::to_string(n) + ", m)")
+                                    .c_str());
+        check_sample_time(h, fn);
+        sim::Linearisation l;
+        l.A = Eigen::Map<const RowMatrix>(a.data(), n, n);
+        l.B = Eigen::Map<const RowMatrix>(b.data(), n, static_cast<Eigen::Index>(b.shape(1)));
+        l.f = f.is_none() ? Eigen::VectorXd::Zero(n) : vector_in(f, fn, "f", n);
+        const char* bad = !l.A.allFinite() ? "A" : !l.B.allFinite() ? "B" : !l.f.allFinite() ? "f" : nullptr;
+        if (bad) throw nb::value_error(("softrne.discretise_zoh: " + std::string(bad) + " is not finite").c_str());
+        return sim::discretise_zoh(l, h);
+      },
+      "A"_a, "B"_a, "h"_a, "f"_a = nb::none(),
+      "The zero-order-hold discretisation of x' = A x + B u + f for the sample time h (s): "
+      "x_k+1 = Ad x_k + Bd u_k + cd, by the exponential of the augmented matrix [[A, B, f], [0, 0, 0]] h "
+      "(Van Loan; sim::discretise_zoh). f None: 0 (then cd = 0). Returns a DiscreteLinearisation "
+      "(Ad, Bd, cd = ... unpacks it).");
+
+  nb::class_<ControllerObservation>(m, "ControllerInput",
+                                    "What a controller of simulate_closed_loop sees at sample k (new arrays "
+                                    "at every sample).")
+      .def_ro("k", &ControllerObservation::k, "The sample index: t = k * control_period.")
+      .def_ro("t", &ControllerObservation::t, "The time, s.")
+      .def_ro("angles", &ControllerObservation::angles,
+              "The measured angles (nq,), rad: the sensors' gain .* q + offset (what simulate returns).")
+      .def_ro("velocities", &ControllerObservation::velocities, "Their rates (nq,), rad/s: gain .* qd.")
+      .def_ro("state", &ControllerObservation::state,
+              "The simulator's whole state (num_states,) [q, qd, effect states], for designs that assume "
+              "full-state knowledge (Robot.linearise's x).")
+      .def("__repr__", [](const ControllerObservation& o) {
+        return "softrne.ControllerInput(k=" + std::to_string(o.k) + ", t=" + number_text(o.t) + ")";
+      });
+
+  nb::class_<sim::ClosedLoopSimulation>(m, "ClosedLoopSimulation",
+                                        "A run of simulate_closed_loop on the sample grid t_k = k * "
+                                        "control_period, k = 0..N (fewer rows if it failed).")
+      .def_prop_ro("t", [](const sim::ClosedLoopSimulation& s) { return vector_out(s.t); }, "The sample times (N + 1,), s.")
+      .def_prop_ro("states", [](const sim::ClosedLoopSimulation& s) { return matrix_out(s.states); },
+                   "The state at each sample, (N + 1, num_states).")
+      .def_prop_ro("angles", [](const sim::ClosedLoopSimulation& s) { return matrix_out(s.angles); },
+                   "The measured angles the controller saw, (N + 1, nq), rad.")
+      .def_prop_ro("commands", [](const sim::ClosedLoopSimulation& s) { return matrix_out(s.commands); },
+                   "The controller's outputs clamped to [p_min, p_max], (N + 1, num_pressures), Pa.")
+      .def_prop_ro("pressures", [](const sim::ClosedLoopSimulation& s) { return matrix_out(s.pressures); },
+                   "The pressures held over [t_k, t_k+1): the commands delayed by delay_periods "
+                   "(initial_pressures before), (N + 1, num_pressures), Pa; row N acts after the run. "
+                   "simulate(robot, t, pressures, q0, interpolation='zoh') replays the run open loop.")
+      .def_prop_ro("ok", &sim::ClosedLoopSimulation::ok, "True if the run reached the last sample.")
+      .def_prop_ro("message", [](const sim::ClosedLoopSimulation& s) { return s.result.message; },
+                   "'' if ok; else the one-line reason and the time reached.")
+      .def_prop_ro("t_reached", [](const sim::ClosedLoopSimulation& s) { return s.result.t_reached; },
+                   "The last time the solution is known at, s.")
+      .def_prop_ro("stats", [](const sim::ClosedLoopSimulation& s) { return stats_dict(s.result.stats); },
+                   "The solver's counters over the run: steps, rhs_evals, jac_evals, "
+                   "rhs_evals_for_jacobian_fd, error_test_failures, nonlinear_convergence_failures, "
+                   "restarts (one per sample), wall_seconds.")
+      .def("__len__", [](const sim::ClosedLoopSimulation& s) { return static_cast<size_t>(s.t.size()); })
+      .def("__repr__", [](const sim::ClosedLoopSimulation& s) {
+        return "softrne.ClosedLoopSimulation(" + std::to_string(s.t.size()) + " samples, " +
+               (s.ok() ? std::string("ok") : "failed: " + s.result.message) + ")";
+      });
+
+  m.def(
+      "simulate_closed_loop",
+      [](const Robot& r, const ControllerFunction& controller, double t_end, double control_period, const ArrayLike& q0,
+         int delay_periods, double p_min, double p_max, const ArrayLike& initial_pressures, bool check,
+         const nb::kwargs& kw) {
+        const char* fn = "simulate_closed_loop";
+        const std::string prefix = "softrne.simulate_closed_loop: ";
+        if (!PyCallable_Check(controller.ptr())) throw nb::type_error((prefix + "controller is not callable").c_str());
+        if (!(control_period > 0) || !std::isfinite(control_period))
+          throw nb::value_error((prefix + "control_period must be positive and finite (got " + number_text(control_period) + ")").c_str());
+        if (!(t_end > 0) || !std::isfinite(t_end))
+          throw nb::value_error((prefix + "t_end must be positive and finite (got " + number_text(t_end) + ")").c_str());
+        if (t_end / control_period > 1e8) throw nb::value_error((prefix + "more than 1e8 control periods").c_str());
+        if (delay_periods < 0)
+          throw nb::value_error((prefix + "delay_periods must be >= 0 (got " + std::to_string(delay_periods) + ")").c_str());
+        if (std::isnan(p_min) || std::isnan(p_max) || !(p_min <= p_max))
+          throw nb::value_error((prefix + "p_min (" + number_text(p_min) + ") must not exceed p_max (" + number_text(p_max) + ")").c_str());
+        const Eigen::VectorXd q = q0.is_none() ? Eigen::VectorXd() : robot_vector(q0, fn, "q0", r.desc.nq, "coordinates");
+        sim::ClosedLoopOptions opt;
+        if (!initial_pressures.is_none()) {
+          opt.initial_pressures = robot_vector(initial_pressures, fn, "initial_pressures", r.desc.num_inputs, "pressures");
+          if (!opt.initial_pressures.allFinite()) throw nb::value_error((prefix + "initial_pressures are not finite").c_str());
+        }
+        opt.delay_periods = delay_periods;
+        opt.p_min = p_min;
+        opt.p_max = p_max;
+        const double periods = std::max(1.0, std::ceil(t_end / control_period - 1e-9));
+        opt.simulation = simulation_options(kw, 0.0, periods * control_period, fn, true);
+
+        // The controller runs with the GIL (the integration runs without it). A Python
+        // exception it raises (or a bad return value) is kept and raised again here, after
+        // the run, as itself; the C++ loop sees a ControllerError and stops at that sample.
+        std::optional<nb::python_error> raised;
+        const sim::Controller c = [&](const sim::ControllerInput& in) -> Eigen::VectorXd {
+          nb::gil_scoped_acquire gil;
+          try {
+            nb::object ret = controller(nb::cast(ControllerObservation{in.k, in.t, vector_out(in.angles),
+                                                                       vector_out(in.velocities), vector_out(in.state)}));
+            return controller_pressures(r, ret, in);
+          } catch (nb::python_error& e) {
+            raised.emplace(std::move(e));
+          }
+          throw std::runtime_error("the Python controller raised an exception");
+        };
+        sim::ClosedLoopSimulation res = run_interruptible([&](const std::atomic<bool>& stop) {
+          opt.simulation.cvode.stop = &stop;
+          return sim::simulate_closed_loop(r.desc, c, q, t_end, control_period, opt);
+        });
+        if (raised) throw nb::python_error(std::move(*raised));
+        if (!res.ok()) {
+          if (res.result.message.rfind("invalid arguments: ", 0) == 0)
+            throw nb::value_error((prefix + res.result.message.substr(19)).c_str());
+          if (check) throw softrne::cli::Failure(prefix + res.result.message);
+        }
+        return res;
+      },
+      "robot"_a, "controller"_a, "t_end"_a, "control_period"_a, "q0"_a = nb::none(), nb::kw_only(),
+      "delay_periods"_a = 0, "p_min"_a = 0.0, "p_max"_a = std::numeric_limits<double>::infinity(),
+      "initial_pressures"_a = nb::none(), "check"_a = true, "solver_options"_a,
+      "Simulates the arm under a controller sampled every control_period seconds from t = 0 to the first "
+      "sample at or after t_end (sim::simulate_closed_loop), starting at rest at the measured angles q0 "
+      "(None: 0) under initial_pressures.\n\n"
+      "At each sample t_k = k control_period, controller(s) is called with s a ControllerInput: s.k, "
+      "s.t, s.angles (nq,) and s.velocities (nq,) (measured), s.state (num_states,). It returns the "
+      "num_pressures chamber pressures (Pa, array-like of shape (num_pressures,)); they are clamped to "
+      "[p_min, p_max] and held (zero-order hold) over one period, delay_periods samples later "
+      "(initial_pressures, default 0 Pa and clamped too, act before and set the effects' initial "
+      "states). The integrator (CVODE BDF, AutoDiff Jacobian) restarts at every sample and runs "
+      "without the GIL; the controller runs with it.\n\n"
+      "Returns a ClosedLoopSimulation (t, states, angles, commands, pressures, ok, message, stats). An "
+      "exception the controller raises propagates unchanged; a return value of the wrong shape or a "
+      "non-finite pressure raises ValueError (None: TypeError) naming the sample. An integration that "
+      "fails raises SimulationError, or with check=False returns the samples before the failure with "
+      "ok False and the message. Solver options: rtol, atol, atol_velocity, jacobian, max_steps, "
+      "max_wall_seconds as for simulate (interpolation and smooth do not apply).");
 
   m.def(
       "_stack_recordings",
