@@ -1045,7 +1045,7 @@ NB_MODULE(_softrne, m) {
       .def_prop_ro("stats", [](const sim::ClosedLoopSimulation& s) { return stats_dict(s.result.stats); },
                    "The solver's counters over the run: steps, rhs_evals, jac_evals, "
                    "rhs_evals_for_jacobian_fd, error_test_failures, nonlinear_convergence_failures, "
-                   "restarts (one per sample), wall_seconds.")
+                   "restarts (one per sample inside the run: N - 1), wall_seconds.")
       .def("__len__", [](const sim::ClosedLoopSimulation& s) { return static_cast<size_t>(s.t.size()); })
       .def("__repr__", [](const sim::ClosedLoopSimulation& s) {
         return "softrne.ClosedLoopSimulation(" + std::to_string(s.t.size()) + " samples, " +
