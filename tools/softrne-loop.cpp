@@ -19,22 +19,23 @@ namespace {
 
 // Writes what tools/plot_loop.py draws: simulated angles before and after on both data sets,
 // and the simulation residual (measured - simulated) on train before and after; then runs it.
+// The simulations are the loop's own (LoopResult keeps them; a model that did not simulate
+// leaves its file out), so the plots show exactly what the report's numbers measured.
 void write_plot_data(const std::string& dir, const softrne::fit::LoopResult& r, const softrne::io::Dataset& train,
-                     const softrne::io::Dataset& test, const softrne::fit::LoopOptions& opt) {
+                     const softrne::io::Dataset& test) {
   using namespace softrne;
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir))
     throw io::InputError(io::Category::WriteFailed, dir, "", "cannot create the plot folder" +
                          (ec ? ": " + ec.message() : std::string()));
-  auto sim = [&](const ArmDescription& d, const io::Dataset& data, const std::string& name) {
-    const auto s = fit::simulate_dataset(d, data, opt.fit.simulation);
-    if (s.ok()) io::write_trajectory_csv(dir + "/" + name, data.t, s.angles, d.coordinate_names);
+  auto write = [&](const Eigen::MatrixXd& angles, const io::Dataset& data, const std::string& name) {
+    if (angles.size()) io::write_trajectory_csv(dir + "/" + name, data.t, angles, r.baseline.fitted.coordinate_names);
   };
-  sim(r.baseline.fitted, train, "train_baseline.csv");
-  sim(r.final_fit.fitted, train, "train_final.csv");
-  sim(r.baseline.fitted, test, "test_baseline.csv");
-  sim(r.final_fit.fitted, test, "test_final.csv");
+  write(r.baseline.angles, train, "train_baseline.csv");
+  write(r.final_fit.angles, train, "train_final.csv");
+  write(r.baseline_test_angles, test, "test_baseline.csv");
+  write(r.final_test_angles, test, "test_final.csv");
   const auto& names = r.baseline.fitted.coordinate_names;
   if (r.baseline_residual.size()) io::write_trajectory_csv(dir + "/residual_baseline.csv", train.t, r.baseline_residual, names);
   if (r.final_residual.size()) io::write_trajectory_csv(dir + "/residual_final.csv", train.t, r.final_residual, names);
@@ -114,7 +115,7 @@ int main(int argc, char** argv) {
       throw cli::Failure(e.what());
     }
     cli::throw_if_interrupted("the closed loop");
-    if (!plots_dir.empty()) write_plot_data(plots_dir, r, train, test, opt);
+    if (!plots_dir.empty()) write_plot_data(plots_dir, r, train, test);
     nlohmann::ordered_json report = cli::loop_report_json(r, true, opt);
     // Per held-out recording, the median error before and after (several test recordings).
     const std::vector<cli::RecordingMedians> medians = cli::loop_test_medians(r, test);
