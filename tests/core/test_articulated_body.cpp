@@ -302,8 +302,8 @@ TEST(OwnBodyInertia, SpatialAndCouplingAgainstIndependentConstruction) {
       EXPECT_LT(rel_err(spatial, ref), 1e-15);
     };
     const Matrix3d R = kc.R_base_distal;
-    check_spatial(cc.mass, kc.r_base_com, R * kc.inertia_com * R.transpose(), oc.spatial);
-    check_spatial(link.mass, link.com, link.inertia, ol.spatial);
+    check_spatial(cc.mass, kc.r_base_com, R * kc.inertia_com * R.transpose(), oc.spatial());
+    check_spatial(link.mass, link.com, link.inertia, ol.spatial());
 
     // Coupling column k = the RNE's wrench at the base of a lone segment for qddot = e_k at
     // rest without gravity (backward_step of the body's d'Alembert load).
@@ -341,7 +341,7 @@ TEST(OwnBodyInertia, BodyRigidWithTheDistalFrameWouldBeWrong) {
   Eigen::Matrix<double, 6, 2> Se = kin.J_distal;
   for (int k = 0; k < 2; ++k)
     Se.col(k).head<3>() += kin.r_base_distal.cross(kin.J_distal.col(k).tail<3>());
-  const Eigen::Matrix2d D_rigid = Se.transpose() * own.spatial * Se;
+  const Eigen::Matrix2d D_rigid = Se.transpose() * own.spatial() * Se;
   const double rigid_err = rel_err(D_rigid / M.norm(), M / M.norm());
   std::printf("[ info ] lone CC joint: |D_rigid - M| / |M| = %.3f (aba uses J_com: M exactly)\n",
               rigid_err);

@@ -459,7 +459,7 @@ TEST(DistributedOwnInertia, MatchesRneOfSingleSegment) {
     Eigen::Matrix<double, 6, 1> w, m;
     w << data.wrench[0].force, data.wrench[0].torque;
     m << a0, Vector3d::Zero();
-    EXPECT_LT((own.spatial * m - w).norm(), 1e-13 * w.norm());
+    EXPECT_LT((own.spatial() * m - w).norm(), 1e-13 * w.norm());
   }
 }
 

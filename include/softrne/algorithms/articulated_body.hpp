@@ -230,9 +230,9 @@ bool articulated_passes(const ChainT& chain, typename ChainT::Data& data) {
     }
     // Plus the own bodies' rigid inertia about O (they move with the base frame's motion).
     if constexpr (Segment::has_body) {
-      A += own.spatial.template topLeftCorner<3, 3>();
-      B += own.spatial.template topRightCorner<3, 3>();
-      C += own.spatial.template bottomRightCorner<3, 3>();
+      A.diagonal().array() += own.mass;
+      B -= skew(own.first_moment);
+      C += own.inertia_origin;
     }
     beyond = true;
   });

@@ -19,16 +19,18 @@
 ///   body's share of M (what backward_step's power-conjugate projection gives).
 ///
 /// Segments whose own mass is several rigid sub-bodies (the quadrature disks of a
-/// distributed-inertia CC segment, segments/sub_bodies.hpp) sum the same blocks over them.
+/// distributed-inertia CC segment, segments/sub_bodies.hpp) sum the same blocks over them:
+/// add_body() is the one place the blocks of a body are written. articulated_body.hpp takes
+/// all of them from here, mass_matrix.hpp the sub-bodies' (it folds a lumped body into its
+/// composite instead, see there).
 
 #include <type_traits>
-#include <utility>
 
 #include <Eigen/Core>
 
-#include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/algorithms/rnea_steps.hpp"
 #include "softrne/segments/sub_bodies.hpp"
+#include "softrne/spatial/inertia_transforms.hpp"
 #include "softrne/spatial/skew.hpp"
 
 namespace softrne {
@@ -37,48 +39,56 @@ namespace softrne {
 /// (linear; angular); see the file comment.
 template <class Scalar, int NQ>
 struct OwnBodyInertia {
-  /// Rigid spatial inertia of the own bodies: wrench (f; n_O) = spatial (a_O; alpha) for
-  /// motion rigid with the base frame.
-  Eigen::Matrix<Scalar, 6, 6> spatial;
-  /// Column k: the wrench the own bodies need for qddot = e_k with the base at rest.
-  Eigen::Matrix<Scalar, 6, NQ> coupling;
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;  ///< a 3x3 matrix
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;  ///< a 3-vector
+  Scalar mass{0};                               ///< \f$\sum_b m_b\f$, kg
+  Vector3 first_moment = Vector3::Zero();       ///< \f$h = \sum_b m_b r_b\f$, kg m
+  /// \f$I_O = \sum_b I_b - m_b [r_b]_\times^2\f$, about the base origin, kg m^2.
+  Matrix3 inertia_origin = Matrix3::Zero();
+  /// Column k: the wrench (force; moment about O) the own bodies need for qddot = e_k with the
+  /// base at rest.
+  Eigen::Matrix<Scalar, 6, NQ> coupling = Eigen::Matrix<Scalar, 6, NQ>::Zero();
   /// Their joint-space inertia \f$\sum_b S_b^T \mathcal I_b S_b\f$ (their share of M).
-  Eigen::Matrix<Scalar, NQ, NQ> joint;
+  Eigen::Matrix<Scalar, NQ, NQ> joint = Eigen::Matrix<Scalar, NQ, NQ>::Zero();
+
+  /// \return The rigid spatial inertia about O: wrench (f; n_O) = spatial() (a_O; alpha) for
+  ///   motion rigid with the base frame.
+  Eigen::Matrix<Scalar, 6, 6> spatial() const {
+    Eigen::Matrix<Scalar, 6, 6> I;
+    const Matrix3 H = skew(first_moment);
+    I.template topLeftCorner<3, 3>() = mass * Matrix3::Identity();
+    I.template topRightCorner<3, 3>() = -H;
+    I.template bottomLeftCorner<3, 3>() = H;
+    I.template bottomRightCorner<3, 3>() = inertia_origin;
+    return I;
+  }
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
 namespace detail {
 
-/// \brief One rigid body (mass m, centre c, inertia I_c about it in base axes, centre velocity
-/// Jacobian Jv and angular Jacobian Jw relative to the base frame) into out.
+/// \brief Adds one rigid body to out: mass m, centre c, inertia I_c about its centre in base
+/// axes, centre velocity Jacobian Jv and angular Jacobian Jw relative to the base frame. Fills
+/// the upper triangle of out.joint only (own_body_inertia mirrors it once at the end).
 template <class Scalar, int NQ, class JvT, class JwT>
-void one_body_inertia(const Scalar& m, const Eigen::Matrix<Scalar, 3, 1>& c,
-                      const Eigen::Matrix<Scalar, 3, 3>& I_c, const JvT& Jv, const JwT& Jw,
-                      OwnBodyInertia<Scalar, NQ>& out) {
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+void add_body(const Scalar& m, const Eigen::Matrix<Scalar, 3, 1>& c,
+              const Eigen::Matrix<Scalar, 3, 3>& I_c, const JvT& Jv, const JwT& Jw,
+              OwnBodyInertia<Scalar, NQ>& out) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  // Rigid spatial inertia about O: f = m (a_O + alpha x c), n_O = I_c alpha + c x f, i.e.
-  // [m 1, -m [c]x; m [c]x, I_c - m [c]x^2].
-  const Matrix3 mC = m * skew(c);
-  out.spatial.template topLeftCorner<3, 3>() = m * Matrix3::Identity();
-  out.spatial.template topRightCorner<3, 3>() = -mC;
-  out.spatial.template bottomLeftCorner<3, 3>() = mC;
-  Matrix3 I_O = I_c;
-  add_shift(I_O, c, Vector3(Scalar(0.5) * m * c));  // parallel axis: I_c - m [c]x [c]x
-  out.spatial.template bottomRightCorner<3, 3>() = I_O;
+  // Rigid part about O: f = m (a_O + alpha x c), n_O = I_c alpha + c x f.
+  out.mass += m;
+  out.first_moment += m * c;
+  out.inertia_origin += I_c;
+  add_shift(out.inertia_origin, c, Vector3(Scalar(0.5) * m * c));  // parallel axis
   if constexpr (NQ > 0) {
     for (int k = 0; k < NQ; ++k) {
       // The body's d'Alembert wrench about O for qddot = e_k (eqs. 16-18 at rest).
       const Vector3 f = m * Jv.col(k);
       const Vector3 t = I_c * Jw.col(k);
-      out.coupling.col(k).template head<3>() = f;
-      out.coupling.col(k).template tail<3>() = t + c.cross(f);
-      // joint(j, k) = J_v,j . m J_v,k + J_w,j . I_c J_w,k, once per pair (exactly symmetric).
-      for (int j = 0; j <= k; ++j) {
-        const Scalar s = Jv.col(j).dot(f) + Jw.col(j).dot(t);
-        out.joint(j, k) = s;
-        out.joint(k, j) = s;
-      }
+      out.coupling.col(k).template head<3>() += f;
+      out.coupling.col(k).template tail<3>() += t + c.cross(f);
+      // joint(j, k) = J_v,j . m J_v,k + J_w,j . I_c J_w,k, upper triangle.
+      for (int j = 0; j <= k; ++j) out.joint(j, k) += Jv.col(j).dot(f) + Jw.col(j).dot(t);
     }
   } else {
     (void)Jv;
@@ -86,11 +96,11 @@ void one_body_inertia(const Scalar& m, const Eigen::Matrix<Scalar, 3, 1>& c,
   }
 }
 
-/// \brief The own body of a segment with `has_body`. Lumped (CC joint, rigid link): mass
-/// seg.mass at kin.r_base_com, inertia \f$R I_c R^T\f$ about it (I_c = kin.inertia_com in
+/// \brief The own body of a segment with `has_body`, from zero. Lumped (CC joint, rigid link):
+/// mass seg.mass at kin.r_base_com, inertia \f$R I_c R^T\f$ about it (I_c = kin.inertia_com in
 /// distal axes, eq. 19), centre of mass moving with J_com (not with the distal frame: eq. 9)
 /// and turning with the angular rows of J_distal. Made of sub-bodies (distributed CC joint):
-/// the sum over them (sub_body_inertia), each with its own Jacobians.
+/// the sum over them, each with its own Jacobians. out.joint is exactly symmetric.
 template <class Segment>
 void own_body_inertia(const Segment& seg, const typename Segment::Kinematics& kin,
                       OwnBodyInertia<typename Segment::Scalar, Segment::nq>& out) {
@@ -98,18 +108,10 @@ void own_body_inertia(const Segment& seg, const typename Segment::Kinematics& ki
   using Scalar = typename Segment::Scalar;
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
   constexpr int n = Segment::nq;
+  out = OwnBodyInertia<Scalar, n>();
   if constexpr (num_sub_bodies<Segment> > 0) {
     (void)seg;
-    SubBodyInertia<Scalar, n> b;
-    sub_body_inertia(kin, b);
-    const Matrix3 H = skew(b.first_moment);
-    out.spatial.template topLeftCorner<3, 3>() = b.mass * Matrix3::Identity();
-    out.spatial.template topRightCorner<3, 3>() = -H;
-    out.spatial.template bottomLeftCorner<3, 3>() = H;
-    out.spatial.template bottomRightCorner<3, 3>() = b.inertia_origin;
-    out.coupling.template topRows<3>() = b.force;
-    out.coupling.template bottomRows<3>() = b.torque;
-    out.joint = b.joint;
+    for (const auto& b : kin.sub_bodies) add_body<Scalar, n>(b.mass, b.r_base_body, b.inertia, b.J_v, b.J_w, out);
   } else {
     // Inertia about the centre of mass in base axes (eq. 18 turns I_c alpha_distal by R).
     Matrix3 I_c;
@@ -117,9 +119,11 @@ void own_body_inertia(const Segment& seg, const typename Segment::Kinematics& ki
       I_c = kin.inertia_com;
     else
       I_c = rotate_symmetric(kin.R_base_distal, kin.inertia_com);
-    one_body_inertia<Scalar, n>(seg.mass, kin.r_base_com, I_c, kin.J_com,
-                                kin.J_distal.template bottomRows<3>(), out);
+    add_body<Scalar, n>(seg.mass, kin.r_base_com, I_c, kin.J_com, kin.J_distal.template bottomRows<3>(), out);
   }
+  if constexpr (n > 1)
+    for (int k = 0; k < n; ++k)
+      for (int j = 0; j < k; ++j) out.joint(k, j) = out.joint(j, k);
 }
 
 }  // namespace detail

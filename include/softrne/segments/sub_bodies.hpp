@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// \brief Segments whose own mass is several rigid sub-bodies (the quadrature disks of a
-/// distributed-inertia CC segment): their kinematics record and their composite inertia.
+/// distributed-inertia CC segment): their kinematics record. Their inertia as the algorithms
+/// see it is algorithms/own_inertia.hpp's.
 
 #include <array>
 #include <cstddef>
@@ -51,53 +52,6 @@ namespace detail {
 /// Number of rigid sub-bodies a segment's own mass is made of (0: one lumped body, if any).
 template <class Segment>
 constexpr int num_sub_bodies = Segment::Kinematics::num_sub_bodies;
-
-/// \brief The own sub-bodies of one segment as the composite-inertia sweeps see them, about
-/// the segment's base origin, base axes.
-template <class Scalar, int NQ>
-struct SubBodyInertia {
-  Scalar mass{0};
-  Eigen::Matrix<Scalar, 3, 1> first_moment;     ///< \f$\sum_b m_b r_b\f$
-  Eigen::Matrix<Scalar, 3, 3> inertia_origin;   ///< \f$\sum_b I_b - m_b [r_b]_\times^2\f$
-  Eigen::Matrix<Scalar, 3, NQ> force;           ///< column k: \f$\sum_b m_b J_{v,b,k}\f$
-  Eigen::Matrix<Scalar, 3, NQ> torque;          ///< column k: about the base origin
-  Eigen::Matrix<Scalar, NQ, NQ> joint;          ///< \f$\sum_b m_b J_v^T J_v + J_w^T I_b J_w\f$
-  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
-};
-
-/// \brief Sums the sub-bodies: rigid composite (mass, first moment, inertia about the base
-/// origin), the d'Alembert wrench about the base origin for qddot = e_k (base at rest, no
-/// velocity), and the joint-space inertia (each pair once: exactly symmetric).
-template <class Scalar, int NQ, int NB>
-void sub_body_inertia(const MultiBodyKinematics<Scalar, NQ, NB>& kin,
-                      SubBodyInertia<Scalar, NQ>& out) {
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  out.mass = Scalar(0);
-  out.first_moment.setZero();
-  out.inertia_origin.setZero();
-  out.force.setZero();
-  out.torque.setZero();
-  out.joint.setZero();
-  for (const auto& b : kin.sub_bodies) {
-    const Vector3& r = b.r_base_body;
-    out.mass += b.mass;
-    out.first_moment += b.mass * r;
-    // I_b - m [r]x^2 = I_b + m (|r|^2 1 - r r^T)
-    const Scalar rr = r.squaredNorm();
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        out.inertia_origin(i, j) += b.inertia(i, j) - b.mass * r(i) * r(j) + (i == j ? b.mass * rr : Scalar(0));
-    for (int k = 0; k < NQ; ++k) {
-      const Vector3 f = b.mass * b.J_v.col(k);
-      const Vector3 t = b.inertia * b.J_w.col(k);
-      out.force.col(k) += f;
-      out.torque.col(k) += t + r.cross(f);
-      for (int j = 0; j <= k; ++j) out.joint(j, k) += b.J_v.col(j).dot(f) + b.J_w.col(j).dot(t);
-    }
-  }
-  for (int k = 0; k < NQ; ++k)
-    for (int j = 0; j < k; ++j) out.joint(k, j) = out.joint(j, k);
-}
 
 }  // namespace detail
 }  // namespace softrne
