@@ -70,6 +70,7 @@
 #include "softrne/algorithms/rnea_steps.hpp"
 #include "softrne/config.hpp"
 #include "softrne/segments/segment_list.hpp"
+#include "softrne/spatial/frame_placement.hpp"
 #include "softrne/spatial/skew.hpp"
 
 namespace softrne {
@@ -106,19 +107,6 @@ bool invert_spd_small(const MatD& D, MatDinv& Dinv) {
   }
 }
 
-/// \brief \f$[r]_\times M\f$: r x each column of M (18 multiplications instead of 27).
-template <class Scalar>
-Eigen::Matrix<Scalar, 3, 3> cross_columns(const Eigen::Matrix<Scalar, 3, 1>& r,
-                                          const Eigen::Matrix<Scalar, 3, 3>& M) {
-  Eigen::Matrix<Scalar, 3, 3> out;
-  for (int j = 0; j < 3; ++j) {
-    out(0, j) = r(1) * M(2, j) - r(2) * M(1, j);
-    out(1, j) = r(2) * M(0, j) - r(0) * M(2, j);
-    out(2, j) = r(0) * M(1, j) - r(1) * M(0, j);
-  }
-  return out;
-}
-
 /// \brief The two sweeps on the kinematics in data, with data.qddot = tau - b on entry and
 /// the accelerations on exit (see the file comment). \return false if some D is not positive
 /// definite.
@@ -130,7 +118,8 @@ bool articulated_passes(const ChainT& chain, typename ChainT::Data& data) {
   // Articulated inertia of everything beyond the current frame, [A B; B^T C] in 3x3 blocks
   // (A, C symmetric), and its force (pf; pn); about the distal origin in distal axes before
   // a segment is visited, about its base origin in base axes after.
-  Matrix3 A = Matrix3::Zero(), B = Matrix3::Zero(), C = Matrix3::Zero();
+  ArticulatedInertia<Scalar> IA;
+  Matrix3 &A = IA.A, &B = IA.B, &C = IA.C;
   Vector3 pf = Vector3::Zero(), pn = Vector3::Zero();
   bool ok = true;
   bool beyond = false;  // false while nothing lies beyond the current frame (A = B = C = 0)
@@ -138,35 +127,15 @@ bool articulated_passes(const ChainT& chain, typename ChainT::Data& data) {
   chain.backward(data, [&](const auto& seg, const auto& kin, int i, int offset) {
     using Segment = std::decay_t<decltype(seg)>;
     constexpr int n = Segment::nq;
-    constexpr bool turns = !has_identity_rotation<Segment>::value;
     constexpr bool shifts = !has_zero_translation<Segment>::value;
-    const Matrix3& R = kin.R_base_distal;
+    const auto X = placement_of<Segment>(kin);
     const Vector3& r_e = kin.r_base_distal;
 
-    // Into base axes: I -> diag(R,R) I diag(R,R)^T, p -> diag(R,R) p.
-    if (beyond && turns) {
-      A = rotate_symmetric(R, A);
-      C = rotate_symmetric(R, C);
-      const Matrix3 BRt = B * R.transpose();
-      B.noalias() = R * BRt;
-      pf = R * pf;
-      pn = R * pn;
-    }
-    // About the base origin: X^T I X with X = [1, -E; 0, 1], E = [r_e]x:
-    // A' = A, B' = B - A E, C' = C + E B + (E B)^T - E A E; p' = (pf; pn + r_e x pf).
-    // E M is r_e x each column of M, and A E = -(E A)^T for symmetric A.
-    if (beyond && shifts) {
-      const Matrix3 EA = cross_columns(r_e, A);
-      const Matrix3 EB = cross_columns(r_e, B);
-      const Matrix3 EAE = cross_columns(r_e, Matrix3(-EA.transpose()));
-      for (int r = 0; r < 3; ++r)
-        for (int c = r; c < 3; ++c) {
-          const Scalar v = C(r, c) + EB(r, c) + EB(c, r) - EAE(r, c);
-          C(r, c) = v;
-          C(c, r) = v;
-        }
-      B += EA.transpose();
-      pn += r_e.cross(pf);
+    // Into base axes and about the base origin: I -> X^T I X, p -> (R pf; R pn + r_e x R pf).
+    if (beyond) {
+      X.to_base(IA);
+      pf = X.rotate(pf);
+      pn = X.shift_torque(X.rotate(pn), pf);
     }
 
     // The segment's own bodies (own_inertia.hpp), then elimination of its coordinates.
@@ -243,8 +212,8 @@ bool articulated_passes(const ChainT& chain, typename ChainT::Data& data) {
   chain.forward(data, [&](const auto& seg, const auto& kin, int i, int offset) {
     using Segment = std::decay_t<decltype(seg)>;
     constexpr int n = Segment::nq;
-    constexpr bool turns = !has_identity_rotation<Segment>::value;
     constexpr bool shifts = !has_zero_translation<Segment>::value;
+    const auto X = placement_of<Segment>(kin);
     (void)seg;
     if constexpr (n > 0) {
       const auto& ws = data.articulated[static_cast<std::size_t>(i)];
@@ -255,18 +224,14 @@ bool articulated_passes(const ChainT& chain, typename ChainT::Data& data) {
       const Eigen::Matrix<Scalar, n, 1> qdd = ws.D_inv.template topLeftCorner<n, n>() * rhs;
       data.qddot.template segment<n>(offset) = qdd;
       // Distal motion a_e = X a_B + J qddot (the shift uses the base's alpha).
-      if constexpr (shifts) {
-        acc += alpha.cross(kin.r_base_distal);
-        acc.noalias() += kin.J_distal.template topRows<3>() * qdd;
-      }
+      acc = X.point_acceleration(acc, alpha);
+      if constexpr (shifts) acc.noalias() += kin.J_distal.template topRows<3>() * qdd;
       alpha.noalias() += kin.J_distal.template bottomRows<3>() * qdd;
-    } else if constexpr (shifts) {
-      acc += alpha.cross(kin.r_base_distal);
+    } else {
+      acc = X.point_acceleration(acc, alpha);
     }
-    if constexpr (turns) {
-      acc = kin.R_base_distal.transpose() * acc;
-      alpha = kin.R_base_distal.transpose() * alpha;
-    }
+    acc = X.rotate_back(acc);
+    alpha = X.rotate_back(alpha);
   });
   return true;
 }

@@ -9,6 +9,7 @@
 #include "softrne/algorithms/kinematics.hpp"
 #include "softrne/algorithms/own_inertia.hpp"
 #include "softrne/algorithms/rnea.hpp"
+#include "softrne/spatial/frame_placement.hpp"
 #include "softrne/spatial/inertia_transforms.hpp"
 
 namespace softrne {
@@ -62,9 +63,7 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
 
   // Composite beyond the current frame: mass, first moment, inertia about the frame origin,
   // in the distal frame of the segment being visited (after it: in its base frame).
-  Scalar c_mass(0);
-  Vector3 c_h = Vector3::Zero();
-  Matrix3 c_I = Matrix3::Zero();
+  RigidInertia<Scalar> composite;
 
   chain.backward(data, [&](const auto& seg, const auto& kin, int, int offset) {
     using Segment = std::decay_t<decltype(seg)>;
@@ -103,16 +102,12 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
     }
     // The composite in the base orientation (about the distal origin), plus the own body's
     // inertia about its centre of mass: both turn with alpha alike.
-    if constexpr (lumped) c_I += kin.inertia_com;
-    Vector3 h;
-    Matrix3 I_rot;
-    if constexpr (turns) {
-      h = R * c_h;
-      I_rot = rotate_symmetric(R, c_I);
-    } else {
-      h = c_h;
-      I_rot = c_I;
-    }
+    const auto X = placement_of<Segment>(kin);
+    if constexpr (lumped) composite.inertia += kin.inertia_com;
+    X.rotate(composite);
+    const Scalar& c_mass = composite.mass;
+    const Vector3& h = composite.first_moment;
+    const Matrix3& I_rot = composite.inertia;
 
     if constexpr (n > 0) {
       const auto Jv = kin.J_distal.template topRows<3>();
@@ -185,8 +180,6 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
     }
     // Every pending wrench about the base origin; the composite likewise (shift by r_e),
     // plus the own body (at r_c).
-    c_I = I_rot;
-    c_h = h;
     if constexpr (shifts) {
       if (first_pending < nq) {
         // r_e in the pending wrenches' orientation
@@ -196,18 +189,17 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
           P.col(c).template tail<3>() += r_p.cross(f);
         }
       }
-      add_shift(c_I, r_e, Vector3(h + Scalar(0.5) * c_mass * r_e));
-      c_h += c_mass * r_e;
     }
-    if constexpr (lumped) {
+    X.shift_to_base(composite);
+    if constexpr (lumped) {  // its inertia about its centre of mass is in already
       const Vector3& r_c = kin.r_base_com;
-      add_shift(c_I, r_c, Vector3(Scalar(0.5) * seg.mass * r_c));
-      c_h += seg.mass * r_c;
-      c_mass += seg.mass;
+      add_shift(composite.inertia, r_c, Vector3(Scalar(0.5) * seg.mass * r_c));
+      composite.first_moment += seg.mass * r_c;
+      composite.mass += seg.mass;
     } else if constexpr (sub_bodies) {
-      c_I += own.inertia_origin;
-      c_h += own.first_moment;
-      c_mass += own.mass;
+      composite.inertia += own.inertia_origin;
+      composite.first_moment += own.first_moment;
+      composite.mass += own.mass;
     }
   });
 }
