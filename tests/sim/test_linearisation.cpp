@@ -2,7 +2,8 @@
 //  - A = df/dx and B = df/dp against central finite differences of ArmDynamics<double>::rhs
 //    (the simulator's right-hand side) at random states of an arm with effects that have
 //    states of their own (actuator_lag, viscoelastic) and effects that change the pressures;
-//  - one zero-order-hold step x1 = x* + Ad dx0 + Bd dp + cd around an equilibrium against
+//  - one zero-order-hold step x1 = x* + Ad dx0 + Bd dp + cd around an equilibrium
+//    (static_equilibrium: every state's rate vanishes there, the effects' states included) against
 //    CVODE (ArmSystem, tight tolerances) over one sample with constant pressures: the
 //    difference is second order in the deviation (halving it quarters the difference).
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "softrne/arm/arm_dynamics.hpp"
+#include "softrne/arm/equilibrium.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 #include "softrne/sim/linearisation.hpp"
 #include "test_arms.hpp"
@@ -127,25 +129,16 @@ TEST(Linearisation, ArmSystemJacobianIsTheStateJacobian) {
   EXPECT_EQ((f - lin.f).cwiseAbs().maxCoeff(), 0.0);
 }
 
-/// x' = f(x, p) = 0 by Newton's method on A (converges quadratically from rest).
-VectorXd equilibrium(const ArmDescription& d, const VectorXd& p) {
-  softrne::sim::ArmJacobian jac(d);
-  VectorXd x = softrne::initial_state(d, VectorXd(), p);
-  for (int it = 0; it < 30; ++it) {
-    const softrne::sim::Linearisation lin = softrne::sim::linearise(jac, x, p);
-    if (lin.f.cwiseAbs().maxCoeff() < 1e-12) break;
-    x -= lin.A.partialPivLu().solve(lin.f);
-  }
-  return x;
-}
-
 TEST(Linearisation, OneZeroOrderHoldStepMatchesTheSimulatorAroundAnEquilibrium) {
   const ArmDescription d = arm_with_state_effects();
   const int n = d.num_states(), m = d.num_inputs;
   VectorXd p_eq(m);
   const double pattern[4] = {60e3, 10e3, 35e3, 20e3};  // bends u and v of every joint
   for (int i = 0; i < m; ++i) p_eq(i) = pattern[i % 4];
-  const VectorXd x_eq = equilibrium(d, p_eq);
+  // static_equilibrium solves for the angles only; every state's rate must vanish, so this
+  // also checks that it holds the effects' states at rest at the answer (the viscoelastic
+  // branch relaxed where the arm is, not where Newton started).
+  const VectorXd x_eq = softrne::rest_state(d, softrne::static_equilibrium(d, p_eq), p_eq);
   softrne::ArmDynamics<double> f(d);
   VectorXd f_eq(n);
   f.rhs(x_eq, p_eq, f_eq);

@@ -161,11 +161,33 @@ class ArmDynamics {
   VectorS p_eff_, tau_;
 };
 
+/// \brief The state at rest at the coordinates q under the pressures p: [q, 0, the effects'
+/// internal states at their at-rest values at q and p] (an actuator lag's pressures equal to p,
+/// a Maxwell branch relaxed at q, ...). What initial_state() and static_equilibrium() start from.
+/// \param[in] d The arm.
+/// \param[in] q The coordinates (nq), not the measured angles.
+/// \param[in] p The pressures, Pa.
+/// \return The state (num_states).
+SOFTRNE_SIM_INLINE Eigen::VectorXd rest_state(const ArmDescription& d, const Eigen::VectorXd& q, const Eigen::VectorXd& p)
+#if SOFTRNE_SIM_BODIES
+{
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(d.num_states());
+  x.head(d.nq) = q;
+  for (std::size_t k = 0; k < d.effects.size(); ++k) {
+    auto xs = x.segment(2 * d.nq + d.effect_state_offsets[k], d.effect_state_size(k));
+    std::visit([&](const auto& e) { e.initial_states(d.joints, q, p, xs); }, d.effects[k]);
+  }
+  return x;
+}
+#else
+;
+#endif
+
 /// \brief Initial state: at the first measured configuration with the measurement model
 /// inverted (q0 = (y0 - offset) ./ gain), at rest or at the measured rates (qdot0 = ydot0 ./
-/// gain), effect states from q0 and the first recorded pressures (their at-rest values there:
-/// a recording that starts in motion starts its effects' internal states as if at rest). An
-/// empty y0 means q0 = 0; an empty ydot0, at rest.
+/// gain), effect states from q0 and the first recorded pressures (their at-rest values there,
+/// rest_state(): a recording that starts in motion starts its effects' internal states as if
+/// at rest). An empty y0 means q0 = 0; an empty ydot0, at rest.
 /// \param[in] d The arm.
 /// \param[in] q0_measured The first measured angles y0 (nq), or empty.
 /// \param[in] p0 The first recorded pressures, Pa.
@@ -176,17 +198,14 @@ SOFTRNE_SIM_INLINE Eigen::VectorXd initial_state(const ArmDescription& d, const 
                                                  const Eigen::VectorXd& qdot0_measured = Eigen::VectorXd())
 #if SOFTRNE_SIM_BODIES
 {
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(d.num_states());
-  if (q0_measured.size() == d.nq) x.head(d.nq) = d.coordinates_from_measured(q0_measured);
+  Eigen::VectorXd x = rest_state(d,
+                                 q0_measured.size() == d.nq ? d.coordinates_from_measured(q0_measured)
+                                                            : Eigen::VectorXd(Eigen::VectorXd::Zero(d.nq)),
+                                 p0);
   if (qdot0_measured.size() == d.nq) {
     Eigen::VectorXd gain, offset;
     d.measurement(gain, offset);
     x.segment(d.nq, d.nq) = qdot0_measured.cwiseQuotient(gain);
-  }
-  const Eigen::VectorXd q0 = x.head(d.nq);
-  for (std::size_t k = 0; k < d.effects.size(); ++k) {
-    auto xs = x.segment(2 * d.nq + d.effect_state_offsets[k], d.effect_state_size(k));
-    std::visit([&](const auto& e) { e.initial_states(d.joints, q0, p0, xs); }, d.effects[k]);
   }
   return x;
 }

@@ -16,7 +16,7 @@
 namespace softrne {
 
 /// \brief Configuration q at which the arm rests under pressures p: qddot(q, qdot = 0) = 0 with
-/// the effect states at their at-rest values (initial_state()). Damped Newton on the
+/// the effect states at their at-rest values at q (rest_state()). Damped Newton on the
 /// accelerations of eq. 23, Jacobian by central differences (step 1e-6 rad), at most 0.3 rad
 /// per step and halved until the residual drops.
 /// \param[in] d The arm.
@@ -29,10 +29,11 @@ inline Eigen::VectorXd static_equilibrium(const ArmDescription& d, const Eigen::
   using Vec = Eigen::VectorXd;
   ArmDynamics<double> f(d);
   const int n = d.nq;
-  Vec x = initial_state(d, Vec(), p), xd(x.size());
+  Vec x(d.num_states()), xd(x.size());
   auto acc = [&](const Vec& qq) {
-    x.head(n) = qq;
-    x.segment(n, n).setZero();
+    // At rest at qq: the effects' internal states at their at-rest values at qq, not at the
+    // starting guess (a Maxwell branch at rest is relaxed where the arm is, effects/viscoelastic.hpp).
+    x = rest_state(d, qq, p);
     f.rhs(x, p, xd);
     return Vec(xd.segment(n, n));
   };
