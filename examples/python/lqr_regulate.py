@@ -4,8 +4,7 @@ the zero-order-hold discretisation of its linearisation, in closed loop with the
 simulator, against holding the pose's pressures open loop. numpy only.
 
 Steps:
- 1. the pose: the equilibrium x_eq under chamber pressures p_eq (Newton on
-    Robot.state_derivative with the Jacobian of Robot.linearise);
+ 1. the pose: the equilibrium x_eq under chamber pressures p_eq (Robot.static_equilibrium);
  2. A, B at (x_eq, p_eq) and Ad, Bd for the control period h (discretise_zoh; cd = 0 at an
     equilibrium);
  3. the gain K of the infinite-horizon discrete LQR: the discrete algebraic Riccati equation
@@ -32,21 +31,6 @@ import softrne
 
 ARM = pathlib.Path(__file__).resolve().parents[1] / "data" / "arm-a-1"
 P_MAX = 150e3  # Pa, the bundled data's valve range
-
-
-def equilibrium(robot: softrne.Robot, p: np.ndarray) -> np.ndarray:
-    """The state at rest under the pressures p: f(x, p) = 0 with qd = 0, by Newton on the
-    acceleration rows, d qdd / d q from the linearisation."""
-    nq = robot.nq
-    x = robot.initial_state(None, p)
-    for _ in range(50):
-        f = robot.state_derivative(x, p)
-        if np.abs(f).max() < 1e-12:
-            return x
-        A = robot.linearise(x, p).A
-        x[:nq] -= np.linalg.solve(A[nq:2 * nq, :nq], f[nq:2 * nq])
-        x[2 * nq:] = robot.initial_state(x[:nq], p)[2 * nq:]  # effect states at rest there
-    raise RuntimeError("Newton did not converge to an equilibrium")
 
 
 def dlqr(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray, tol: float = 1e-12) -> tuple[np.ndarray, int]:
@@ -76,7 +60,7 @@ def main() -> int:
     # 1. The pose: one chamber of each joint at 40 to 70 kPa, the others at 20 kPa.
     p_eq = np.full(m, 20e3)
     p_eq[0::4] = np.linspace(70e3, 40e3, len(p_eq[0::4]))
-    x_eq = equilibrium(robot, p_eq)
+    x_eq = robot.static_equilibrium(p_eq)
     q_eq = x_eq[:nq]
 
     # 2. The discretised linearisation; the design works in kPa (better-scaled B).

@@ -37,6 +37,7 @@
 #include "common/report.hpp"
 #include "softrne/algorithms/derivatives.hpp"
 #include "softrne/arm/arm_description.hpp"
+#include "softrne/arm/equilibrium.hpp"
 #include "softrne/fit/arm_fit.hpp"
 #include "softrne/fit/loop.hpp"
 #include "softrne/fit/parallel_for.hpp"
@@ -836,6 +837,23 @@ NB_MODULE(_softrne, m) {
       "The linearisation of the state equation at (x, p) (sim::linearise): A = df/dx (n, n) and B = "
       "df/dp (n, num_pressures), exact (forward-mode AutoDiff), and f = f(x, p), so that near (x, p) "
       "d(dx)/dt = f + A dx + B dp. Raises ValueError if f or its derivatives are not finite there.");
+  robot.def(
+      "static_equilibrium",
+      [](const Robot& r, const ArrayLike& p, const ArrayLike& q_guess) {
+        const Eigen::VectorXd pv = robot_vector(p, "static_equilibrium", "p", r.desc.num_inputs, "pressures");
+        const Eigen::VectorXd q0 = q_guess.is_none()
+                                       ? Eigen::VectorXd()
+                                       : robot_vector(q_guess, "static_equilibrium", "q_guess", r.desc.nq, "coordinates");
+        try {
+          return vector_out(softrne::rest_state(r.desc, softrne::static_equilibrium(r.desc, pv, q0), pv));
+        } catch (const std::runtime_error& e) {
+          throw nb::value_error((std::string("softrne.Robot.static_equilibrium: ") + e.what()).c_str());
+        }
+      },
+      "p"_a, "q_guess"_a = nb::none(),
+      "The state x (num_states,) at which the arm rests under the chamber pressures p (num_pressures,), Pa: "
+      "f(x, p) = 0 with qd = 0 and the effects' states at rest there (softrne::static_equilibrium, a damped "
+      "Newton from q_guess (nq,) coordinates, None: the straight arm). Raises ValueError if it finds none.");
 
   // ---- data sets -------------------------------------------------------------------------
   nb::class_<softrne::io::Dataset>(m, "Dataset",

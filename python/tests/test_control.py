@@ -63,18 +63,32 @@ def bending_pressures(robot: softrne.Robot) -> np.ndarray:
     return p
 
 
-def equilibrium(robot: softrne.Robot, p: np.ndarray) -> np.ndarray:
-    """The state at rest under p (f(x, p) = 0) by Newton on the accelerations' rows."""
-    nq = robot.nq
-    x = robot.initial_state(None, p)
-    for _ in range(50):
-        f = robot.state_derivative(x, p)
-        if np.abs(f).max() < 1e-12:
-            return x
-        lin = robot.linearise(x, p)
-        x[:nq] -= np.linalg.solve(lin.A[nq:2 * nq, :nq], f[nq:2 * nq])
-        x[2 * nq:] = robot.initial_state(x[:nq], p)[2 * nq:]
-    raise AssertionError(f"no equilibrium: |f| = {np.abs(f).max()}")
+def viscoelastic_robot() -> softrne.Robot:
+    """The bundled arm with a Maxwell branch on every joint (6 more states, at rest where q is)."""
+    d = softrne.Robot.from_json(ARM / "robot.json").to_dict()
+    d["effects"] = [{"name": "viscoelastic", "params": {"k": 3.0, "tau": 0.3}}]
+    return softrne.Robot.from_dict(d)
+
+
+@pytest.mark.parametrize("make", [lambda: softrne.Robot.from_json(ARM / "robot.json"), lag_robot, viscoelastic_robot],
+                         ids=["declared", "actuator_lag", "viscoelastic"])
+def test_static_equilibrium_is_where_the_simulation_comes_to_rest(make):
+    """Robot.static_equilibrium (Newton on the accelerations) against its definition, f(x, p) = 0,
+    and against an independent path: the simulator run from the straight arm under the same
+    constant pressures until it has settled (60 s; the slowest mode decays in about 2 s)."""
+    robot = make()
+    p = bending_pressures(robot)
+    x = robot.static_equilibrium(p)
+    assert x.shape == (robot.num_states,)
+    np.testing.assert_array_equal(x[robot.nq:2 * robot.nq], np.zeros(robot.nq))
+    assert np.abs(robot.state_derivative(x, p)).max() < 1e-9
+    assert np.abs(x[:robot.nq]).max() > 0.05  # it bends
+    settled = softrne.simulate(robot, [0.0, 60.0], [p, p], None, **TIGHT)[-1]
+    np.testing.assert_allclose(settled, x[:robot.nq], rtol=0, atol=1e-7)
+    # From a guess near the answer, the same answer; a guess of the wrong size is refused.
+    np.testing.assert_allclose(robot.static_equilibrium(p, x[:robot.nq] + 0.01), x, rtol=0, atol=1e-10)
+    with pytest.raises(ValueError, match="static_equilibrium.*q_guess"):
+        robot.static_equilibrium(p, np.zeros(robot.nq + 1))
 
 
 # ---- the state and its equation --------------------------------------------------------
@@ -196,7 +210,7 @@ def test_discrete_step_at_an_equilibrium_equals_the_simulator(robot):
     and the held pressures are Ad and Bd exactly: central differences of the simulator in a
     perturbation (dq, dp) equal Ad dx + Bd dp up to O(eps^2)."""
     p_eq = bending_pressures(robot)
-    x_eq = equilibrium(robot, p_eq)
+    x_eq = robot.static_equilibrium(p_eq)
     assert np.abs(x_eq[:6]).max() > 0.05  # it bends
     h = 0.02
     d = robot.linearise(x_eq, p_eq).discretise_zoh(h)
