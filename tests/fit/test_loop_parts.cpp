@@ -5,6 +5,7 @@
 // measurement effect.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <random>
 #include <set>
@@ -153,6 +154,41 @@ TEST(LoopCandidates, EveryEffectInEveryAllowedScopeOnceAndNothingAlreadyHeld) {
   }
   EXPECT_GT(before, after);
   EXPECT_GT(after, 0);
+}
+
+TEST(LoopCandidates, OnAnArmOfBothKindsTheSharedScopeIsAlsoTriedOverEachKind) {
+  // The two-joint arm with a revolute joint between its CC joints (as random arm 1007,
+  // C-L-Rz-C): an effect that acts on both kinds gets three shared candidates, over all its
+  // joints and over the two CC joints (one revolute joint: its own per-joint candidate covers
+  // it); an effect of the chambers only gets one. Without the revolute joint, one each.
+  const ArmDescription cc_only = build_arm(softrne_test::two_joint_spec());
+  io::RobotSpec spec = softrne_test::two_joint_spec();
+  io::RevoluteJointSpec rz;
+  rz.name = "rev1";
+  rz.stiffness = 0.1;
+  rz.damping = 0.003;
+  spec.segments.insert(spec.segments.begin() + 2, rz);
+  const ArmDescription mixed = build_arm(spec);
+  ASSERT_EQ(mixed.joints.size(), 3u);
+  auto shared_joint_sets = [](const ArmDescription& d, const std::string& name) {
+    std::set<std::vector<int>> sets;
+    for (const AnyEffect& e : fit::enumerate_candidates(d))
+      if (effect_name(e) == name && effect_base(e).scope == Scope::Shared) {
+        std::vector<int> j = effect_base(e).joints;
+        std::sort(j.begin(), j.end());
+        EXPECT_TRUE(sets.insert(j).second) << name << ": a shared candidate twice";
+      }
+    return sets;
+  };
+  int cc1 = -1, cc2 = -1;
+  for (std::size_t j = 0; j < mixed.joints.size(); ++j)
+    if (mixed.joints[j].is_cc()) (cc1 < 0 ? cc1 : cc2) = static_cast<int>(j);
+  ASSERT_GE(cc2, 0);
+  const std::set<std::vector<int>> both{{0, 1, 2}, {cc1, cc2}};
+  EXPECT_EQ(shared_joint_sets(mixed, "coulomb_friction"), both);
+  EXPECT_EQ(shared_joint_sets(mixed, "sensor_gain"), both);
+  EXPECT_EQ(shared_joint_sets(mixed, "pressure_stiffening"), (std::set<std::vector<int>>{{cc1, cc2}}));
+  EXPECT_EQ(shared_joint_sets(cc_only, "coulomb_friction"), (std::set<std::vector<int>>{{0, 1}}));
 }
 
 TEST(LoopScreen, PredictsTheExactGainOfAnOffsetAndNoneForAnAbsentEffect) {

@@ -686,6 +686,15 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     // refitted already (confirm keeps the better refit). The held-out gain below then
     // chooses: on a truly per-joint effect the shared scope puts the effect where it is not
     // and loses.
+    // On an arm with CC and revolute joints each shared scope that holds the narrower one's
+    // joints is refitted (over all joints, over the joints of its kind: candidates.hpp).
+    auto holds = [](const AnyEffect& wide, const AnyEffect& narrow) {
+      const std::vector<int>& w = effect_base(wide).joints;
+      if (w.empty()) return true;  // an effect on the arm as a whole (payload)
+      for (int j : effect_base(narrow).joints)
+        if (std::find(w.begin(), w.end(), j) == w.end()) return false;
+      return true;
+    };
     const std::vector<int> passed_before_shared = passing;
     for (int narrow_index : passed_before_shared) {
       const std::size_t narrow = static_cast<std::size_t>(narrow_index);
@@ -693,9 +702,8 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       if (effect_base(e).scope == Scope::Shared) continue;
       for (std::size_t r = 0; r < scores.size(); ++r) {
         const AnyEffect& o = cands[score_cand[r]].effect;
-        if (scores[r].name != scores[narrow].name || effect_base(o).scope != Scope::Shared) continue;
+        if (scores[r].name != scores[narrow].name || effect_base(o).scope != Scope::Shared || !holds(o, e)) continue;
         confirm_beside(narrow, r, "the shared scope of", fitted_if_same_size);
-        break;
       }
     }
     // The converse: a passing shared scope with no passing narrower scope of its effect has
@@ -718,7 +726,9 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
       if (is_passing_narrower(scores[shared].name)) continue;
       for (std::size_t r = 0; r < scores.size(); ++r) {
         const AnyEffect& o = cands[score_cand[r]].effect;
-        if (scores[r].name != scores[shared].name || effect_base(o).scope == Scope::Shared) continue;
+        if (scores[r].name != scores[shared].name || effect_base(o).scope == Scope::Shared ||
+            !holds(cands[score_cand[shared]].effect, o))
+          continue;
         confirm_beside(shared, r, "a narrower scope of", fitted_if_same_size);
         break;
       }
