@@ -260,6 +260,41 @@ TEST(LoopParts, WithoutEffectIsTheArmBuiltWithoutIt) {
   EXPECT_GT((a - c).cwiseAbs().maxCoeff(), 1e-3);
 }
 
+TEST(LoopParts, WithEffectReplacedIsTheArmBuiltWithTheReplacementInItsPlace) {
+  // Reference: the arm built directly with the replacement at the same place. The replaced
+  // effect (actuator lag) has internal states and its replacement (Coulomb friction) has none,
+  // so the Dahl element's state slice after it moves.
+  const ArmDescription base = build_arm(softrne_test::two_joint_spec());
+  auto lag = make_effect_at_neutral("actuator_lag", base, Scope::Shared);
+  effect_base(lag).params.setConstant(0.08);
+  auto offset = make_effect_at_neutral("angle_offset", base, Scope::PerCoordinate, {1});
+  effect_base(offset).params << 0.02, -0.01;
+  auto dahl = make_effect_at_neutral("hysteresis", base, Scope::Shared);
+  effect_base(dahl).params << 0.3, 40.0;
+  auto coulomb = make_effect_at_neutral("coulomb_friction", base, Scope::Shared);
+  effect_base(coulomb).params << 0.2;
+  ArmDescription all = base, expected = base;
+  for (const auto& e : {lag, offset, dahl}) add_effect(all, e);
+  for (const auto& e : {coulomb, offset, dahl}) add_effect(expected, e);
+  const ArmDescription got = fit::detail::with_effect_replaced(all, 0, coulomb);
+  ASSERT_EQ(got.effects.size(), 3u);
+  EXPECT_EQ(effect_name(got.effects[0]), "coulomb_friction");
+  EXPECT_EQ(effect_name(got.effects[1]), "angle_offset");
+  EXPECT_EQ(effect_name(got.effects[2]), "hysteresis");
+  EXPECT_EQ(got.num_effect_states, expected.num_effect_states);
+  EXPECT_EQ(got.effect_state_offsets, expected.effect_state_offsets);
+  EXPECT_LT(got.num_effect_states, all.num_effect_states);
+  const io::Dataset data = softrne_test::synthetic_dataset(all, 3.0, 0.7, 5u);
+  sim::ArmSimulationOptions o;
+  const Eigen::MatrixXd a = fit::detail::simulated_angles(got, data, o);
+  const Eigen::MatrixXd b = fit::detail::simulated_angles(expected, data, o);
+  ASSERT_GT(a.size(), 0);
+  EXPECT_EQ((a - b).cwiseAbs().maxCoeff(), 0.0);
+  // Positive control: the replacement changed the motion.
+  const Eigen::MatrixXd c = fit::detail::simulated_angles(all, data, o);
+  EXPECT_GT((a - c).cwiseAbs().maxCoeff(), 1e-3);
+}
+
 TEST(LoopParts, DistributeInertiaSwitchesLumpedCcJointsOnly) {
   ArmDescription d = build_arm(softrne_test::two_joint_spec());
   ASSERT_TRUE(fit::detail::distribute_cc_inertia(d));

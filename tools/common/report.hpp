@@ -289,7 +289,8 @@ inline nlohmann::ordered_json loop_report_json(const fit::LoopResult& r, bool ha
     effects.push_back(x);
   }
   j["effects"] = effects;
-  // Added in a round, removed by the backward pass once later effects were in.
+  // Added in a round, removed by the backward pass once later effects were in, or replaced by
+  // its simpler limit at the end (run_loop).
   nlohmann::ordered_json removed = nlohmann::ordered_json::array();
   for (const auto& a : r.removed) {
     nlohmann::ordered_json fg = nlohmann::ordered_json::array();

@@ -276,6 +276,16 @@ inline ArmDescription without_effect(const ArmDescription& d, std::size_t k) {
   return w;
 }
 
+/// `d` with its effect number k replaced by `e` (the others keep their order and states).
+inline ArmDescription with_effect_replaced(const ArmDescription& d, std::size_t k, const AnyEffect& e) {
+  ArmDescription w = d;
+  w.effects.clear();
+  w.effect_state_offsets.clear();
+  w.num_effect_states = 0;
+  for (std::size_t i = 0; i < d.effects.size(); ++i) add_effect(w, i == k ? e : d.effects[i]);
+  return w;
+}
+
 /// Sets every CC joint declared lumped to distributed inertia; false if there was none.
 inline bool distribute_cc_inertia(ArmDescription& d) {
   bool changed = false;
@@ -876,6 +886,79 @@ SOFTRNE_FIT_INLINE LoopResult run_loop(const ArmDescription& declared, const io:
     out.added.erase(out.added.begin() + drop);
     for (std::size_t f = 0; f < folds.size(); ++f) detail::adopt(folds[f], drop_trials[f]);
     full_refit(detail::without_effect(current, first + static_cast<std::size_t>(drop)));
+  }
+
+  // Parsimony once more, at the end: a kept effect that contains a simpler one as a limit
+  // (effect_reduces_to: a Dahl element with a small yield angle is Coulomb friction) is replaced
+  // by that limit, in its scope and from its fitted values, when the limit leaves a held-out
+  // error within min_gain of its own (the rule of detail::pick_winner, on the mean of the folds'
+  // ratios) and still earns its place against the model without it (the backward pass's rule).
+  // Within a round the simpler limit is refitted beside the richer effect already; this catches
+  // what rounds cannot: random arm 1028 (Coulomb friction on four CC joints beside a passive
+  // revolute one) took friction over all joints in round 1, a Dahl element on the CC joints
+  // (sigma 100) in round 3 -- where Coulomb friction on those joints was no candidate, the
+  // wider scope holding it -- and the backward pass then dropped the wider friction, leaving
+  // the Dahl element in place of the friction the arm has.
+  for (std::size_t a = 0; a < out.added.size(); ++a) {
+    const std::size_t k = current.effects.size() - out.added.size() + a;
+    const AnyEffect& rich = current.effects[k];
+    const std::string simpler_name = effect_reduces_to(rich);
+    if (simpler_name.empty()) continue;
+    const AnyEffect simpler =
+        make_effect_at_neutral(simpler_name, current, effect_base(rich).scope, effect_base(rich).joints);
+    std::vector<detail::FoldTrial> trials;
+    double mean_ratio = 0;
+    std::vector<double> gains;  // what the simpler limit gains over the model without it
+    bool ok = true;
+    std::string line = "  " + out.added[a].label + " as " + candidate_label(simpler, current) +
+                       ": held-out error";
+    for (auto& f : folds) {
+      AnyEffect s = simpler;
+      effect_base(s).params = effect_reduced_params(f.model.effects[k], simpler);
+      trials.push_back(detail::try_on_fold(f, detail::with_effect_replaced(f.model, k, s), train, refit,
+                                           &out.simulations));
+      ok = ok && trials.back().ok();
+      if (!ok) break;
+      mean_ratio += trials.back().held_rms / f.held_rms / static_cast<double>(folds.size());
+      line += " " + detail::percent(trials.back().gain);
+    }
+    if (ok && mean_ratio <= 1.0 + opt.min_gain) {
+      line += "; without either";
+      for (std::size_t f = 0; ok && f < folds.size(); ++f) {
+        const detail::FoldTrial none = detail::try_on_fold(
+            folds[f], detail::without_effect(trials[f].fit.fitted, k), train, refit, &out.simulations);
+        gains.push_back(none.ok() ? 1.0 - trials[f].held_rms / none.held_rms : 1.0);
+        line += " " + detail::percent(-gains.back());
+        ok = gains.back() >= opt.min_gain;
+      }
+    }
+    const bool replace = ok && mean_ratio <= 1.0 + opt.min_gain;
+    log(line + (replace ? " -> replaced by its simpler limit" : " -> kept"));
+    if (!replace) continue;
+    AddedEffect gone = out.added[a];
+    gone.evidence = "replaced by " + candidate_label(simpler, current) +
+                    ", its simpler limit: held-out training error with the limit instead";
+    AddedEffect kept;
+    kept.effect = simpler;
+    kept.label = candidate_label(simpler, current);
+    kept.selection_gain = gone.selection_gain;
+    kept.fold_gains = gains;
+    kept.evidence = "held-out training error";
+    for (std::size_t f = 0; f < folds.size(); ++f) {
+      gone.evidence += (f ? ", " : " ") + detail::percent(trials[f].gain);
+      kept.evidence += (f ? ", " : " ") + detail::percent(gains[f]);
+    }
+    gone.evidence += " (not more than min_gain above its own)";
+    kept.evidence += " in the " + std::to_string(folds.size()) + " folds against the model without it, in place of " +
+                     gone.label + " (its richer form)";
+    effect_base(kept.effect).params = Eigen::VectorXd::Zero(effect_base(simpler).params.size());
+    for (const auto& t : trials) effect_base(kept.effect).params += effect_base(t.fit.fitted.effects[k]).params;
+    effect_base(kept.effect).params /= static_cast<double>(trials.size());
+    log("replacing " + gone.label + " by " + kept.label);
+    out.removed.push_back(gone);
+    out.added[a] = kept;
+    for (std::size_t f = 0; f < folds.size(); ++f) detail::adopt(folds[f], trials[f]);
+    full_refit(detail::with_effect_replaced(current, k, kept.effect));
   }
 
   out.final_fit = current_fit;
