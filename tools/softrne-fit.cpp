@@ -6,6 +6,7 @@
 
 #include "common/cli.hpp"
 #include "common/outputs.hpp"
+#include "common/robot_file.hpp"
 #include "common/recordings.hpp"
 #include "common/report.hpp"
 #include "softrne/fit/arm_fit.hpp"
@@ -70,12 +71,7 @@ int main(int argc, char** argv) {
     io::Dataset test;
     const bool has_test = !test_paths.empty();
     if (has_test) test = cli::read_recordings(test_paths, spec, true, initial_motion, "--test");
-    ArmDescription desc;
-    try {
-      desc = build_arm(spec);
-    } catch (const std::invalid_argument& e) {
-      throw cli::Failure(robot_path + ": " + e.what());
-    }
+    const ArmDescription desc = cli::build_robot(spec, robot_path);
     if (!quiet)
       opt.optimiser.progress = [nq = desc.nq, angles_only = !train.has_markers](int evals, double cost) {
         // The residual is scaled so that 2 cost = nq * (mean squared angle error) (angles only;

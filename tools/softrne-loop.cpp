@@ -9,6 +9,7 @@
 
 #include "common/cli.hpp"
 #include "common/outputs.hpp"
+#include "common/robot_file.hpp"
 #include "common/recordings.hpp"
 #include "common/report.hpp"
 #include "softrne/fit/loop.hpp"
@@ -98,12 +99,7 @@ int main(int argc, char** argv) {
     const io::RobotSpec spec = io::read_robot_json(robot_path);
     const io::Dataset train = cli::read_recordings(train_paths, spec, true, initial_motion, "--train");
     const io::Dataset test = cli::read_recordings(test_paths, spec, true, initial_motion, "--test");
-    ArmDescription desc;
-    try {
-      desc = build_arm(spec);
-    } catch (const std::invalid_argument& e) {
-      throw cli::Failure(robot_path + ": " + e.what());
-    }
+    const ArmDescription desc = cli::build_robot(spec, robot_path);
     if (!quiet)
       opt.log = [](const std::string& s) { std::fprintf(stderr, "softrne-loop: %s\n", s.c_str()); };
     fit::LoopResult r;

@@ -14,6 +14,7 @@
 
 #include "common/cli.hpp"
 #include "common/outputs.hpp"
+#include "common/robot_file.hpp"
 #include "softrne/arm/arm_description.hpp"
 #include "softrne/arm/markers.hpp"
 #include "softrne/io/csv.hpp"
@@ -145,13 +146,7 @@ int run_sim(int argc, char** argv) {
 
   // Inputs: every problem is an io::InputError naming the file.
   const softrne::io::RobotSpec robot = softrne::io::read_robot_json(robot_path);
-  softrne::ArmDescription desc;
-  try {
-    desc = softrne::build_arm(robot);
-  } catch (const std::invalid_argument& e) {
-    throw softrne::io::InputError(softrne::io::Category::InvalidValue, robot_path, "effects",
-                                  e.what());
-  }
+  const softrne::ArmDescription desc = softrne::cli::build_robot(robot, robot_path);
   const softrne::io::Dataset data = softrne::io::read_dataset(data_path, robot, false);
   const Eigen::Index n = data.t.size();
   const double t0 = data.t(0), t1 = data.t(n - 1);

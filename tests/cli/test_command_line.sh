@@ -62,6 +62,23 @@ for tool in sim fit loop make_case; do
   unset -n ok
 done
 
+# ---- a robot file that reads but does not build: the same status and message in every tool --
+# (exit 3, an input file's problem, README "Exit codes"; the file named once)
+# (the file's last "]" closes "segments"; an "effects" entry with no parameters follows it)
+sed '$d' "$robot" | sed '$d' >"$tmp/unbuildable.json"
+echo '  ], "effects": [{"name": "stiffening", "joints": ["joint1"], "params": {}}]}' >>"$tmp/unbuildable.json"
+bad_robot=$tmp/unbuildable.json
+for tool in sim fit loop; do
+  declare -n ok=${tool}_ok
+  exe=${!tool}
+  expect_failure 3 "$exe" "$tool: robot file that does not build" \
+    "$(basename "$exe"): $bad_robot: effects[0] 'stiffening': field 'params': no parameters" \
+    --robot "$bad_robot" "${ok[@]:2}"
+  [[ $(grep -o "$bad_robot" "$tmp/stderr.txt" | wc -l) -eq 1 ]] ||
+    fail "$tool: the robot file is not named exactly once: $(cat "$tmp/stderr.txt")"
+  unset -n ok
+done
+
 # ---- integer options take decimal integers only ---------------------------------------------
 for bad in 1.5 1e3 0x10 abc "" " 7"; do
   usage "$fit" "--seed '$bad'" "--seed" "${fit_ok[@]}" --seed "$bad"
