@@ -228,71 +228,65 @@ TEST(LoopScreen, PredictsTheExactGainOfAnOffsetAndNoneForAnAbsentEffect) {
   EXPECT_LT(screen[static_cast<std::size_t>(stiffening)].predicted_gain, 0.5);
 }
 
-TEST(LoopParts, WithoutEffectIsTheArmBuiltWithoutIt) {
-  // Reference: the arm built directly with the other effects, in their order. Effects with
-  // internal states (actuator lag, Dahl hysteresis) around one without (an angle offset), so
-  // that removing the first shifts the others' state slices.
-  const ArmDescription base = build_arm(softrne_test::two_joint_spec());
-  auto lag = make_effect_at_neutral("actuator_lag", base, Scope::Shared);
-  effect_base(lag).params.setConstant(0.08);
-  auto offset = make_effect_at_neutral("angle_offset", base, Scope::PerCoordinate, {1});
-  effect_base(offset).params << 0.02, -0.01;
-  auto dahl = make_effect_at_neutral("hysteresis", base, Scope::Shared);
-  effect_base(dahl).params << 0.3, 40.0;
-  ArmDescription all = base, expected = base;
-  for (const auto& e : {lag, offset, dahl}) add_effect(all, e);
-  for (const auto& e : {offset, dahl}) add_effect(expected, e);
-  const ArmDescription got = fit::detail::without_effect(all, 0);
-  ASSERT_EQ(got.effects.size(), 2u);
-  EXPECT_EQ(effect_name(got.effects[0]), "angle_offset");
-  EXPECT_EQ(effect_name(got.effects[1]), "hysteresis");
+// Three effects on the two-joint arm, for the tests of taking one out or replacing it: two
+// with internal states (actuator lag, Dahl hysteresis) around one without (an angle offset),
+// so that changing the first moves the others' state slices.
+struct ThreeEffects {
+  ArmDescription base = build_arm(softrne_test::two_joint_spec());
+  AnyEffect lag = make_effect_at_neutral("actuator_lag", base, Scope::Shared);
+  AnyEffect offset = make_effect_at_neutral("angle_offset", base, Scope::PerCoordinate, {1});
+  AnyEffect dahl = make_effect_at_neutral("hysteresis", base, Scope::Shared);
+  ArmDescription all = base;
+  ThreeEffects() {
+    effect_base(lag).params.setConstant(0.08);
+    effect_base(offset).params << 0.02, -0.01;
+    effect_base(dahl).params << 0.3, 40.0;
+    for (const auto& e : {lag, offset, dahl}) add_effect(all, e);
+  }
+};
+
+// `got` (made from `all`) has the effects of `expected`, in their order, with the same state
+// slices and the same simulation to the last bit; and it moves differently from `all`.
+void expect_the_arm_built_directly(const ArmDescription& got, const ArmDescription& expected,
+                                   const ArmDescription& all) {
+  ASSERT_EQ(got.effects.size(), expected.effects.size());
+  for (std::size_t k = 0; k < got.effects.size(); ++k)
+    EXPECT_EQ(effect_name(got.effects[k]), effect_name(expected.effects[k]));
   EXPECT_EQ(got.num_effect_states, expected.num_effect_states);
   EXPECT_EQ(got.effect_state_offsets, expected.effect_state_offsets);
-  EXPECT_LT(got.num_effect_states, all.num_effect_states);
   const io::Dataset data = softrne_test::synthetic_dataset(all, 3.0, 0.7, 5u);
   sim::ArmSimulationOptions o;
   const Eigen::MatrixXd a = fit::detail::simulated_angles(got, data, o);
   const Eigen::MatrixXd b = fit::detail::simulated_angles(expected, data, o);
   ASSERT_GT(a.size(), 0);
   EXPECT_EQ((a - b).cwiseAbs().maxCoeff(), 0.0);
-  // Positive control: the removed effect did change the motion.
+  // Positive control: the change did change the motion.
   const Eigen::MatrixXd c = fit::detail::simulated_angles(all, data, o);
   EXPECT_GT((a - c).cwiseAbs().maxCoeff(), 1e-3);
 }
 
+TEST(LoopParts, WithoutEffectIsTheArmBuiltWithoutIt) {
+  // Reference: the arm built directly with the other effects, in their order.
+  const ThreeEffects t;
+  ArmDescription expected = t.base;
+  for (const auto& e : {t.offset, t.dahl}) add_effect(expected, e);
+  const ArmDescription got = fit::detail::without_effect(t.all, 0);
+  EXPECT_LT(got.num_effect_states, t.all.num_effect_states);
+  expect_the_arm_built_directly(got, expected, t.all);
+}
+
 TEST(LoopParts, WithEffectReplacedIsTheArmBuiltWithTheReplacementInItsPlace) {
   // Reference: the arm built directly with the replacement at the same place. The replaced
-  // effect (actuator lag) has internal states and its replacement (Coulomb friction) has none,
-  // so the Dahl element's state slice after it moves.
-  const ArmDescription base = build_arm(softrne_test::two_joint_spec());
-  auto lag = make_effect_at_neutral("actuator_lag", base, Scope::Shared);
-  effect_base(lag).params.setConstant(0.08);
-  auto offset = make_effect_at_neutral("angle_offset", base, Scope::PerCoordinate, {1});
-  effect_base(offset).params << 0.02, -0.01;
-  auto dahl = make_effect_at_neutral("hysteresis", base, Scope::Shared);
-  effect_base(dahl).params << 0.3, 40.0;
-  auto coulomb = make_effect_at_neutral("coulomb_friction", base, Scope::Shared);
+  // effect (actuator lag) has internal states and its replacement (Coulomb friction) none.
+  const ThreeEffects t;
+  auto coulomb = make_effect_at_neutral("coulomb_friction", t.base, Scope::Shared);
   effect_base(coulomb).params << 0.2;
-  ArmDescription all = base, expected = base;
-  for (const auto& e : {lag, offset, dahl}) add_effect(all, e);
-  for (const auto& e : {coulomb, offset, dahl}) add_effect(expected, e);
-  const ArmDescription got = fit::detail::with_effect_replaced(all, 0, coulomb);
-  ASSERT_EQ(got.effects.size(), 3u);
-  EXPECT_EQ(effect_name(got.effects[0]), "coulomb_friction");
-  EXPECT_EQ(effect_name(got.effects[1]), "angle_offset");
-  EXPECT_EQ(effect_name(got.effects[2]), "hysteresis");
-  EXPECT_EQ(got.num_effect_states, expected.num_effect_states);
-  EXPECT_EQ(got.effect_state_offsets, expected.effect_state_offsets);
-  EXPECT_LT(got.num_effect_states, all.num_effect_states);
-  const io::Dataset data = softrne_test::synthetic_dataset(all, 3.0, 0.7, 5u);
-  sim::ArmSimulationOptions o;
-  const Eigen::MatrixXd a = fit::detail::simulated_angles(got, data, o);
-  const Eigen::MatrixXd b = fit::detail::simulated_angles(expected, data, o);
-  ASSERT_GT(a.size(), 0);
-  EXPECT_EQ((a - b).cwiseAbs().maxCoeff(), 0.0);
-  // Positive control: the replacement changed the motion.
-  const Eigen::MatrixXd c = fit::detail::simulated_angles(all, data, o);
-  EXPECT_GT((a - c).cwiseAbs().maxCoeff(), 1e-3);
+  ArmDescription expected = t.base;
+  for (const auto& e : {coulomb, t.offset, t.dahl}) add_effect(expected, e);
+  const ArmDescription got = fit::detail::with_effect_replaced(t.all, 0, coulomb);
+  EXPECT_EQ(effect_name(got.effects.at(0)), "coulomb_friction");
+  EXPECT_LT(got.num_effect_states, t.all.num_effect_states);
+  expect_the_arm_built_directly(got, expected, t.all);
 }
 
 TEST(LoopParts, DistributeInertiaSwitchesLumpedCcJointsOnly) {
