@@ -7,7 +7,7 @@ dotted, the simulation solid. Panel titles carry the mean/median/max absolute er
     python3 tools/plot_simulation.py --measured examples/data/arm-a-1/test.csv \\
         --simulated sim.csv --out sim.png [--title TEXT] [--pressures]
 
---measured: a data CSV (shared/spec/formats.md section 2: t, p{j}_{k}, u{j}, v{j}, ...; '#'
+--measured: a data CSV (docs/formats.md section 2: t, p{j}_{k}, u{j}, v{j}, ...; '#'
 comment lines allowed). --simulated: a softrne-sim output (section 3: t,u1,v1,...). Either may
 be omitted to plot only the other. --pressures adds a top panel with joint 1's pressures
 (like Fig. 4). Needs numpy and matplotlib (tools/install-deps.sh --python).

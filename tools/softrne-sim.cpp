@@ -1,6 +1,6 @@
 // softrne-sim: simulate an arm (robot.json) from recorded chamber pressures (CSV) with CVODE,
 // write the joint angles on the input's time grid and, where the input holds measured angles,
-// print the error table of the paper's Tables I-II (shared/spec/formats.md sections 2, 3, 6).
+// print the error table of the paper's Tables I-II (docs/formats.md sections 2, 3, 6).
 
 #include <algorithm>
 #include <chrono>

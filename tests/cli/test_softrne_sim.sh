@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Command-line contract of softrne-sim (shared/spec/formats.md section 6): on bad input it
+# Command-line contract of softrne-sim (docs/formats.md section 6): on bad input it
 # exits non-zero (< 128: no crash, no signal) with exactly one line on stderr,
 # "softrne-sim: <file>: ...", naming the file (or the option) at fault; on good input it exits
 # 0 and writes t,u1,v1,... on the input's time grid.

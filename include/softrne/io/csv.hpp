@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief CSV tables of measured, commanded and simulated data
-/// (shared/spec/formats.md sections 2 and 3): the data set of a robot (its time,
+/// (docs/formats.md sections 2 and 3): the data set of a robot (its time,
 /// pressure and angle columns, checked against the robot) and the trajectory writer.
 /// The strict reader and the full-precision writer of the tables themselves, and
 /// what they accept, are csv_table.hpp's.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief Numeric CSV tables (shared/spec/formats.md sections 2 and 3): a strict, fast
+/// \brief Numeric CSV tables (docs/formats.md sections 2 and 3): a strict, fast
 /// reader with one-line errors naming file, line and column, and a full-precision writer.
 ///
 /// Accepted: a UTF-8 byte-order mark; CRLF or LF line endings; any number of

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Read and write `robot.json` (format `softrne-robot/1`,
-/// shared/spec/formats.md section 1), with strict validation: every problem is
+/// docs/formats.md section 1), with strict validation: every problem is
 /// an InputError with a one-line message naming the file, the segment and the field.
 /// The schema is here; the strict JSON reading it uses is strict_json.hpp's.
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Plain description of a robot as `robot.json` (format `softrne-robot/1`,
-/// shared/spec/formats.md section 1) holds it: no JSON, no dynamics.
+/// docs/formats.md section 1) holds it: no JSON, no dynamics.
 
 #include <cmath>
 #include <cstddef>
