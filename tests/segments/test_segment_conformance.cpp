@@ -297,6 +297,34 @@ TYPED_TEST(SegmentConformance, LongDoubleAgreesWithDouble) {
 }
 
 // ---------------------------------------------------------------------------------------
+// The placement shortcuts a type declares (identity_rotation, zero_translation; the passes
+// then skip the product or the shift, spatial/frame_placement.hpp) hold exactly on every
+// state; and the two types that should declare one are seen to (a renamed flag would make
+// the shortcut vanish silently).
+static_assert(detail::has_identity_rotation<RigidLink<double>>::value);
+static_assert(detail::has_zero_translation<RevoluteJoint<double>>::value);
+static_assert(!detail::has_identity_rotation<ConstantCurvatureJoint<double>>::value);
+static_assert(!detail::has_zero_translation<DistributedCCJoint<double>>::value);
+
+TYPED_TEST(SegmentConformance, DeclaredPlacementShortcutsHold) {
+  using Segment = TypeParam;
+  const Segment seg = Example<Segment>::make();
+  for (const auto& [q, qd] : states<Segment>(8)) {
+    const auto k = calc(seg, q, qd);
+    if constexpr (detail::has_identity_rotation<Segment>::value) {
+      EXPECT_EQ(k.R_base_distal, Matrix3d::Identity());
+    }
+    if constexpr (detail::has_zero_translation<Segment>::value) {
+      EXPECT_EQ(k.r_base_distal, Vector3d::Zero());
+      if constexpr (Segment::nq > 0) {
+        EXPECT_TRUE((k.J_distal.template topRows<3>().array() == 0.0).all());
+        EXPECT_TRUE((k.Jdot_qdot_distal.template head<3>().array() == 0.0).all());
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------
 TYPED_TEST(SegmentConformance, CalcDoesNotAllocate) {
   using Segment = TypeParam;
   const Segment seg = Example<Segment>::make();

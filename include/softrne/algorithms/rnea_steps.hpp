@@ -9,35 +9,11 @@
 #include <Eigen/Geometry>
 
 #include "softrne/chain/motion.hpp"
-#include "softrne/segments/revolute_joint.hpp"
-#include "softrne/segments/rigid_link.hpp"
 #include "softrne/segments/sub_bodies.hpp"
 #include "softrne/spatial/frame_placement.hpp"
 
 namespace softrne {
 namespace detail {
-
-/// Segments whose distal frame is never rotated relative to their base (R_base_distal is the
-/// identity by construction): the passes skip multiplying by it (bit-identical results).
-template <class Segment>
-struct has_identity_rotation : std::false_type {};
-template <class Scalar>
-struct has_identity_rotation<RigidLink<Scalar>> : std::true_type {};
-/// Segments whose distal origin is their base origin (r_base_distal = 0 by construction, so
-/// the linear rows of J_distal and of Jdot_qdot_distal are zero too).
-template <class Segment>
-struct has_zero_translation : std::false_type {};
-template <class Scalar>
-struct has_zero_translation<RevoluteJoint<Scalar>> : std::true_type {};
-
-/// \brief The placement of a segment's distal frame in its base frame, with the segment
-/// type's shortcuts (spatial/frame_placement.hpp). Refers to kin.
-template <class Segment>
-FramePlacement<typename Segment::Scalar, !has_identity_rotation<Segment>::value,
-               !has_zero_translation<Segment>::value>
-placement_of(const typename Segment::Kinematics& kin) {
-  return {kin.R_base_distal, kin.r_base_distal};
-}
 
 /// \brief Forward step (paper eqs. 11-15) across one segment: from the motion of its base
 /// frame to that of its distal frame, and the d'Alembert load of its own body.

@@ -19,6 +19,9 @@ struct RevoluteJoint {
   using Scalar = Scalar_;                 ///< double, long double or an AutoDiff type
   static constexpr int nq = 1;            ///< the joint angle
   static constexpr bool has_body = false; ///< massless
+  /// r_base_distal = 0 by construction: placements skip the shift (spatial/frame_placement.hpp;
+  /// the conformance suite checks it).
+  static constexpr bool zero_translation = true;
   using Kinematics = SegmentKinematics<Scalar, nq>;  ///< what calc() fills
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;       ///< a 3-vector
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;       ///< a 3x3 matrix

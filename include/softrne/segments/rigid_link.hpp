@@ -16,6 +16,9 @@ struct RigidLink {
   using Scalar = Scalar_;                 ///< double, long double or an AutoDiff type
   static constexpr int nq = 0;            ///< no coordinates
   static constexpr bool has_body = true;  ///< it carries mass
+  /// R_base_distal is the identity by construction: placements skip the product
+  /// (spatial/frame_placement.hpp; the conformance suite checks it).
+  static constexpr bool identity_rotation = true;
   using Kinematics = SegmentKinematics<Scalar, nq>;  ///< what calc() fills
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;       ///< a 3-vector
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;       ///< a 3x3 matrix

@@ -5,7 +5,8 @@
 ///
 /// \f$p_{base} = R\,p_{distal} + r\f$ (R = SegmentKinematics::R_base_distal, r =
 /// r_base_distal). Segments whose R is the identity by construction (rigid links) or whose r
-/// is zero by construction (revolute joints) say so at compile time, and the placement skips
+/// is zero by construction (revolute joints) say so in their own type (`identity_rotation`,
+/// `zero_translation`; detail::placement_of reads them), and the placement skips
 /// the product or the shift: the shortcuts live here, once, instead of at each site of
 /// rnea_steps.hpp, mass_matrix.hpp and articulated_body.hpp (as Pinocchio's transform types
 /// carry their own fast paths). With the flags on, every operation is the plain formula; the
@@ -225,5 +226,36 @@ class FramePlacement {
   const Matrix3& R_;
   const Vector3& r_;
 };
+
+namespace detail {
+
+/// \brief true if Segment declares `static constexpr bool identity_rotation = true`: its distal
+/// frame is never rotated relative to its base (R_base_distal is the identity by
+/// construction, as for a rigid link), so placements skip multiplying by it.
+template <class Segment, class = void>
+struct has_identity_rotation : std::false_type {};
+template <class Segment>
+struct has_identity_rotation<Segment, std::void_t<decltype(Segment::identity_rotation)>>
+    : std::bool_constant<Segment::identity_rotation> {};
+
+/// \brief true if Segment declares `static constexpr bool zero_translation = true`: its distal
+/// origin is its base origin (r_base_distal = 0 by construction, as for a revolute joint, so
+/// the linear rows of J_distal and of Jdot_qdot_distal are zero too).
+template <class Segment, class = void>
+struct has_zero_translation : std::false_type {};
+template <class Segment>
+struct has_zero_translation<Segment, std::void_t<decltype(Segment::zero_translation)>>
+    : std::bool_constant<Segment::zero_translation> {};
+
+/// \brief The placement of a segment's distal frame in its base frame, with the shortcuts its
+/// type declares. Refers to kin.
+template <class Segment>
+FramePlacement<typename Segment::Scalar, !has_identity_rotation<Segment>::value,
+               !has_zero_translation<Segment>::value>
+placement_of(const typename Segment::Kinematics& kin) {
+  return {kin.R_base_distal, kin.r_base_distal};
+}
+
+}  // namespace detail
 
 }  // namespace softrne
