@@ -27,6 +27,29 @@ InputSignal make_signal(Interpolation interp) {
   return InputSignal(t, u, interp);
 }
 
+// PCHIP written independently of the library (polynomial form on each interval, slopes by
+// the Fritsch-Butland mean in the form 3 (h0 + h1) / ((2 h1 + h0) / d0 + (h1 + 2 h0) / d1)).
+double pchip_reference(const Eigen::VectorXd& ts, const Eigen::VectorXd& ys, double t) {
+  const Eigen::Index n = ts.size();
+  if (t <= ts[0]) return ys[0];
+  if (t >= ts[n - 1]) return ys[n - 1];
+  auto d = [&](Eigen::Index i) { return (ys[i + 1] - ys[i]) / (ts[i + 1] - ts[i]); };
+  auto slope = [&](Eigen::Index i) {
+    if (i == 0) return d(0);
+    if (i == n - 1) return d(n - 2);
+    const double d0 = d(i - 1), d1 = d(i);
+    if (d0 == 0 || d1 == 0 || (d0 > 0) != (d1 > 0)) return 0.0;
+    const double h0 = ts[i] - ts[i - 1], h1 = ts[i + 1] - ts[i];
+    return 3 * (h0 + h1) / ((2 * h1 + h0) / d0 + (h1 + 2 * h0) / d1);
+  };
+  Eigen::Index i = 0;
+  while (ts[i + 1] <= t) ++i;
+  const double h = ts[i + 1] - ts[i], x = t - ts[i], di = d(i);
+  const double m0 = slope(i), m1 = slope(i + 1);
+  const double c2 = (3 * di - 2 * m0 - m1) / h, c3 = (m0 + m1 - 2 * di) / (h * h);
+  return ys[i] + x * (m0 + x * (c2 + x * c3));
+}
+
 // Reference: straightforward linear scan.
 Eigen::Vector2d reference(const InputSignal& s, double t, Side side) {
   const Eigen::VectorXd& ts = s.times();
@@ -36,6 +59,11 @@ Eigen::Vector2d reference(const InputSignal& s, double t, Side side) {
     for (Eigen::Index k = 0; k < n; ++k)
       if (side == Side::right ? ts[k] <= t : ts[k] < t) i = k;
     return s.sample(i);
+  }
+  if (s.interpolation() == Interpolation::pchip) {
+    Eigen::MatrixXd ys(n, 2);
+    for (Eigen::Index k = 0; k < n; ++k) ys.row(k) = s.sample(k).transpose();
+    return {pchip_reference(ts, ys.col(0), t), pchip_reference(ts, ys.col(1), t)};
   }
   if (t <= ts[0]) return s.sample(0);
   if (t >= ts[n - 1]) return s.sample(n - 1);
@@ -137,7 +165,8 @@ TEST(InputSignal, SingleSampleIsConstant) {
 }
 
 // Cursor correctness: monotone sweeps (dense and sparse), random jumps, exact
-// sample times, both sides, both interpolations, against a linear scan.
+// sample times, both sides, every interpolation, against a linear scan (and, for PCHIP, an
+// interpolant written here).
 TEST(InputSignal, CursorMatchesLinearScanOnRandomQueries) {
   std::mt19937 rng(12345);
   std::uniform_real_distribution<double> dt(0.001, 0.1);
@@ -147,7 +176,8 @@ TEST(InputSignal, CursorMatchesLinearScanOnRandomQueries) {
   for (int i = 1; i < n; ++i) t[i] = t[i - 1] + dt(rng);
   Eigen::MatrixXd u = Eigen::MatrixXd::Random(n, 2);
 
-  for (Interpolation interp : {Interpolation::zero_order_hold, Interpolation::linear}) {
+  for (Interpolation interp :
+       {Interpolation::zero_order_hold, Interpolation::linear, Interpolation::pchip}) {
     InputSignal s(t, u, interp);
     std::uniform_real_distribution<double> any(t[0] - 1.0, t[n - 1] + 1.0);
     std::uniform_int_distribution<int> any_sample(0, n - 1);
@@ -172,12 +202,78 @@ TEST(InputSignal, CursorMatchesLinearScanOnRandomQueries) {
         s.value(q, value, side);
         s.value(q, value_const, cursor, side);
         const Eigen::Vector2d expected = reference(s, q, side);
-        if ((value - expected).cwiseAbs().maxCoeff() > 1e-14 ||
-            (value_const - expected).cwiseAbs().maxCoeff() > 1e-14)
+        // PCHIP's reference evaluates another form of the same cubic: rounding differs.
+        const double tol = interp == Interpolation::pchip ? 1e-12 : 1e-14;
+        if ((value - expected).cwiseAbs().maxCoeff() > tol ||
+            (value_const - expected).cwiseAbs().maxCoeff() > tol)
           ++mismatches;
       }
     EXPECT_EQ(mismatches, 0) << "interpolation " << static_cast<int>(interp);
   }
+}
+
+// PCHIP by hand on three samples: t = 0, 1, 2 and u = 0, 1, 3 (secants 1 and 2, so the
+// interior slope is their harmonic mean 4/3; the ends take the secants), and on data with an
+// extremum (interior slope 0). At s = 1/2 the Hermite basis is (1/2, 1/8, 1/2, -1/8).
+TEST(InputSignal, PchipClosedForms) {
+  Eigen::VectorXd t(3);
+  t << 0.0, 1.0, 2.0;
+  Eigen::MatrixXd u(3, 2);
+  u << 0, 0,  //
+      1, 1,   //
+      3, 1;
+  InputSignal s(t, u, Interpolation::pchip);
+  Eigen::Vector2d v;
+  s.value(1.5, v);
+  EXPECT_NEAR(v[0], 0.5 * 1 + 0.125 * (4.0 / 3.0) + 0.5 * 3 - 0.125 * 2, 1e-15);  // 23/12
+  EXPECT_NEAR(v[1], 1.0, 1e-15);  // flat at the extremum and, with a zero secant, after it
+  s.value(0.5, v);
+  EXPECT_NEAR(v[0], 0.125 * 1 + 0.5 * 1 - 0.125 * (4.0 / 3.0), 1e-15);
+  EXPECT_NEAR(v[1], 0.125 * 1 + 0.5 * 1, 1e-15);  // 0.625: slopes 1 and 0
+  EXPECT_TRUE(s.breakpoints().empty());           // C1 inside its range
+}
+
+// PCHIP is exact on linear data, C1 at every sample (its one-sided difference quotients agree
+// with each other), and does not overshoot monotone data, on random irregular samples.
+TEST(InputSignal, PchipIsExactOnLinesC1AndMonotone) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> dt(0.005, 0.05), du(0.0, 1.0);
+  const int n = 200;
+  Eigen::VectorXd t(n);
+  Eigen::MatrixXd u(n, 2);
+  t[0] = 0.0;
+  u(0, 1) = 0.0;
+  for (int i = 1; i < n; ++i) {
+    t[i] = t[i - 1] + dt(rng);
+    u(i, 1) = u(i - 1, 1) + (i % 7 == 0 ? 0.0 : du(rng));  // non-decreasing, with flat parts
+  }
+  u.col(0) = (3.0 - 2.0 * t.array()).matrix();  // a line
+  InputSignal s(t, u, Interpolation::pchip);
+  Eigen::Vector2d v;
+  double worst_line = 0, worst_kink = 0, worst_overshoot = 0;
+  for (int i = 0; i + 1 < n; ++i) {
+    for (double f : {0.1, 0.37, 0.5, 0.9}) {
+      const double tq = t[i] + f * (t[i + 1] - t[i]);
+      s.value(tq, v);
+      worst_line = std::max(worst_line, std::abs(v[0] - (3.0 - 2.0 * tq)));
+      worst_overshoot = std::max({worst_overshoot, u(i, 1) - v[1], v[1] - u(i + 1, 1)});
+    }
+    if (i > 0) {  // left and right derivatives at t_i, one-sided quotients with Richardson
+      auto at = [&](double tq) {
+        s.value(tq, v);
+        return v[1];
+      };
+      const double e = 1e-6, c = at(t[i]);
+      auto left = [&](double h) { return (c - at(t[i] - h)) / h; };
+      auto right = [&](double h) { return (at(t[i] + h) - c) / h; };
+      const double dl = 2 * left(e / 2) - left(e), dr = 2 * right(e / 2) - right(e);
+      worst_kink = std::max(worst_kink, std::abs(dr - dl) / std::max(1.0, std::abs(dl)));
+    }
+  }
+  EXPECT_LT(worst_line, 1e-14);
+  EXPECT_LT(worst_overshoot, 1e-12);  // rounding only (h00 + h01 = 1 up to an ulp)
+  // A kink jumps the slope by O(1) of itself; C1 leaves O(e^2 u''') and rounding, ~1e-7.
+  EXPECT_LT(worst_kink, 1e-5);
 }
 
 }  // namespace

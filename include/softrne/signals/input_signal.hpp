@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// \brief A sampled input signal u(t) (pressures, torques): zero-order hold or
-/// linear interpolation, clamped outside the sampled range. Eigen only.
+/// \brief A sampled input signal u(t) (pressures, torques): zero-order hold, linear or
+/// shape-preserving cubic (PCHIP) interpolation, clamped outside the sampled range. Eigen only.
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,14 @@ namespace softrne::signals {
 /// \brief How an InputSignal is evaluated between two sample times.
 enum class Interpolation {
   zero_order_hold,  ///< \f$u(t) = u_i\f$ for \f$t_i \le t < t_{i+1}\f$ (right-continuous steps)
-  linear            ///< \f$u(t) = u_i + (t - t_i)\,(u_{i+1} - u_i)/(t_{i+1} - t_i)\f$
+  linear,           ///< \f$u(t) = u_i + (t - t_i)\,(u_{i+1} - u_i)/(t_{i+1} - t_i)\f$
+  /// Piecewise cubic Hermite with Fritsch-Carlson slopes (PCHIP): continuous first
+  /// derivative, no overshoot at steps, exact on linear data. Why it is the simulator's
+  /// default: recorded pressures are noisy samples of a continuous signal; linear
+  /// interpolation puts a kink at every sample and zero-order hold a jump, and the
+  /// integrator's error test shrinks the step to resolve each one (tens of thousands of steps
+  /// for a 10 s, 100 Hz record). PCHIP removes both at no cost in fidelity.
+  pchip
 };
 
 /// \brief Which one-sided limit to return exactly at a sample time. Only a
@@ -56,7 +63,7 @@ class InputSignal {
   /// one row per sample). Throws std::invalid_argument when an invariant fails.
   /// \param[in] times The N sample times, s, strictly increasing.
   /// \param[in] values N x P, one row per sample.
-  /// \param[in] interpolation Zero-order hold (default) or linear between samples.
+  /// \param[in] interpolation Zero-order hold (default), linear or PCHIP between samples.
   /// \throws std::invalid_argument if there is no sample, the sizes disagree, a value is
   ///   not finite or the times do not increase strictly.
   InputSignal(const Eigen::Ref<const Eigen::VectorXd>& times,
@@ -74,6 +81,7 @@ class InputSignal {
       if (!(times[i] > times[i - 1]))
         throw std::invalid_argument(
             "InputSignal: sample times are not strictly increasing at index " + std::to_string(i));
+    if (interpolation == Interpolation::pchip) compute_pchip_slopes();
   }
 
   /// \return The number of channels P.
@@ -137,7 +145,9 @@ class InputSignal {
   /// Zero-order hold: the sample times \f$t_i\f$ (i >= 1) where the value jumps,
   /// \f$\|u_i - u_{i-1}\|_\infty > \f$ `tolerance`. Linear: the sample times where
   /// the slope changes by more than `tolerance` (infinity norm), counting the
-  /// zero slope of the clamped extension before \f$t_0\f$ and after \f$t_{N-1}\f$.
+  /// zero slope of the clamped extension before \f$t_0\f$ and after \f$t_{N-1}\f$. PCHIP:
+  /// none (its first derivative is continuous inside the range; at the ends the clamped
+  /// extension meets it with the end slope, which integrators cross like any other change).
   /// With densely sampled data almost every sample is a breakpoint; stopping at
   /// each one costs a solver restart, so pass a tolerance or thin the list.
   /// \param[in] tolerance Smallest jump (or slope change) that counts.
@@ -145,6 +155,7 @@ class InputSignal {
   std::vector<double> breakpoints(double tolerance = 0.0) const {
     std::vector<double> result;
     const Eigen::Index n = times_.size();
+    if (interpolation_ == Interpolation::pchip) return result;
     if (interpolation_ == Interpolation::zero_order_hold) {
       for (Eigen::Index i = 1; i < n; ++i)
         if ((samples_.col(i) - samples_.col(i - 1)).cwiseAbs().maxCoeff() > tolerance)
@@ -179,7 +190,7 @@ class InputSignal {
       u = samples_.col(locate(t, side, cursor));
       return;
     }
-    // Linear: continuous, so the side does not matter.
+    // Linear and PCHIP: continuous, so the side does not matter.
     if (!(t > times_[0])) {  // also catches NaN: clamp to the first sample
       u = samples_.col(0);
       return;
@@ -189,8 +200,39 @@ class InputSignal {
       return;
     }
     const Eigen::Index i = locate(t, Side::right, cursor);  // t_i <= t < t_{i+1}
-    const double s = (t - times_[i]) / (times_[i + 1] - times_[i]);
-    u = (1.0 - s) * samples_.col(i) + s * samples_.col(i + 1);
+    const double h = times_[i + 1] - times_[i], s = (t - times_[i]) / h;
+    if (interpolation_ == Interpolation::linear) {
+      u = (1.0 - s) * samples_.col(i) + s * samples_.col(i + 1);
+      return;
+    }
+    // Cubic Hermite basis on [t_i, t_{i+1}] with the slopes m_i, m_{i+1}.
+    const double h00 = (1 + 2 * s) * (1 - s) * (1 - s), h10 = s * (1 - s) * (1 - s);
+    const double h01 = s * s * (3 - 2 * s), h11 = s * s * (s - 1);
+    u = h00 * samples_.col(i) + h10 * h * slopes_.col(i) + h01 * samples_.col(i + 1) +
+        h11 * h * slopes_.col(i + 1);
+  }
+
+  /// Fritsch-Carlson slopes (Fritsch and Carlson, SIAM J. Numer. Anal. 17, 1980; the
+  /// three-point weighted harmonic mean of Fritsch and Butland, as MATLAB's and scipy's
+  /// pchip): zero at a local extremum of the data, one-sided secants at the ends.
+  void compute_pchip_slopes() {
+    const Eigen::Index n = times_.size(), channels = samples_.rows();
+    slopes_ = Eigen::MatrixXd::Zero(channels, n);
+    if (n < 2) return;
+    for (Eigen::Index c = 0; c < channels; ++c) {
+      auto secant = [&](Eigen::Index i) {  // on [t_i, t_{i+1}]
+        return (samples_(c, i + 1) - samples_(c, i)) / (times_[i + 1] - times_[i]);
+      };
+      slopes_(c, 0) = secant(0);
+      slopes_(c, n - 1) = secant(n - 2);
+      for (Eigen::Index i = 1; i + 1 < n; ++i) {
+        const double d0 = secant(i - 1), d1 = secant(i);
+        if (d0 * d1 <= 0) continue;  // local extremum: flat
+        const double h0 = times_[i] - times_[i - 1], h1 = times_[i + 1] - times_[i];
+        const double w1 = 2 * h1 + h0, w2 = h1 + 2 * h0;
+        slopes_(c, i) = (w1 + w2) / (w1 / d0 + w2 / d1);  // weighted harmonic mean
+      }
+    }
   }
 
   /// Index i of the held sample: the largest i with t_i <= t (Side::right) or
@@ -228,6 +270,7 @@ class InputSignal {
 
   Eigen::VectorXd times_;
   Eigen::MatrixXd samples_;  // P x N: sample i is the contiguous column i
+  Eigen::MatrixXd slopes_;   // P x N, PCHIP only: du/dt at each sample
   Interpolation interpolation_ = Interpolation::zero_order_hold;
   SignalCursor cursor_;
 };

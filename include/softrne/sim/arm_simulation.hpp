@@ -50,7 +50,7 @@ struct ArmSimulationOptions {
   /// file comment), CvodeOptions' defaults otherwise.
   CvodeOptions cvode = default_cvode();
   /// How recorded pressures are read between samples (see PressureInterpolation).
-  enum class PressureInterpolation { pchip, linear, zero_order_hold };
+  using PressureInterpolation = signals::Interpolation;  ///< pchip, linear, zero_order_hold
   PressureInterpolation interpolation = PressureInterpolation::pchip;  ///< PCHIP by default
 
   /// Jacobian of the state equation by forward-mode AutoDiff through the templated RNE
@@ -135,10 +135,7 @@ class ArmSystem {
   /// \return The num_inputs pressures, Pa (valid until the next call).
   const Eigen::VectorXd& pressures(double t) {
     const double tr = t - delay_;
-    if (mode_ == ArmSimulationOptions::PressureInterpolation::pchip)
-      pchip_.value(tr, p_);
-    else
-      input_.value(tr, p_, cursor_, t >= segment_end_ ? Side::left : Side::right);
+    input_.value(tr, p_, cursor_, t >= segment_end_ ? Side::left : Side::right);
     return p_;
   }
 
@@ -168,9 +165,7 @@ class ArmSystem {
  private:
   const ArmDescription& desc_;
   ArmJacobian f_;
-  ArmSimulationOptions::PressureInterpolation mode_;
   InputSignal input_;
-  PchipSignal pchip_;
   SignalCursor cursor_;
   Eigen::VectorXd p_;
   double delay_ = 0;
@@ -185,12 +180,7 @@ SOFTRNE_SIM_INLINE ArmSystem::ArmSystem(const ArmDescription& desc, const Eigen:
                                         ArmSimulationOptions::PressureInterpolation mode)
     : desc_(desc),
       f_(desc),
-      mode_(mode),
-      input_(t, pressures,
-             mode == ArmSimulationOptions::PressureInterpolation::zero_order_hold
-                 ? Interpolation::zero_order_hold
-                 : Interpolation::linear),
-      pchip_(t, pressures),
+      input_(t, pressures, mode),
       delay_(desc.input_delay()) {
   p_.resize(desc.num_inputs);
 }
