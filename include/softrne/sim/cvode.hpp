@@ -59,6 +59,9 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include "softrne/sim/eigen_linear_solver.hpp"
+#include "softrne/sim/serial_vector_ops.hpp"
+
 namespace softrne::sim {
 
 /// \brief Settings of one integrate() call.
@@ -79,6 +82,18 @@ struct CvodeOptions {
   /// t* until t + h == t and then spin there until max_steps is exhausted.
   double min_step = 0;
   int max_order = 5;                  ///< BDF order limit, 1..5
+
+  /// Steps between Jacobian evaluations, at most (CVodeSetJacEvalFrequency; 0 = CVODE's 51).
+  /// CVODE evaluates the Jacobian anew whenever Newton's iteration fails to converge with the
+  /// one it holds, so an old Jacobian costs iterations, never accuracy. The arms' Jacobians
+  /// change slowly: 1000 evaluated about 13 times fewer of them than 51 on the bundled and
+  /// eight random arms, with the same number of steps and fewer right-hand sides
+  /// (docs/performance.md).
+  long jacobian_max_age = 1000;
+  /// Steps between updates of the Newton matrix \f$I - \gamma J\f$ (its LU factors), at most
+  /// (CVodeSetLSetupFrequency; 0 = CVODE's 20). CVODE also updates it when \f$\gamma\f$ has
+  /// changed by more than 30 % and after a convergence failure.
+  long newton_matrix_max_age = 100;
   bool use_analytic_jacobian = true;  ///< use System::jacobian when present
   bool verbose = false;               ///< also print CVODE's messages to stderr
 };
@@ -476,13 +491,16 @@ SimulationResult integrate(System& sys, const Eigen::VectorXd& x0,
   detail::ContextPtr ctx(ctx_raw);
   detail::VectorPtr y(N_VNew_Serial(static_cast<sunindextype>(n), ctx.get()));
   if (!y) return setup_error("N_VNew_Serial");
+  detail::use_softrne_vector_ops(y.get());  // before CVodeInit clones it (serial_vector_ops.hpp)
   detail::VectorMap y_map(N_VGetArrayPointer(y.get()), n);
   y_map = x0;
   detail::MatrixPtr A(
       SUNDenseMatrix(static_cast<sunindextype>(n), static_cast<sunindextype>(n), ctx.get()));
   if (!A) return setup_error("SUNDenseMatrix");
-  detail::LinearSolverPtr LS(SUNLinSol_Dense(y.get(), A.get(), ctx.get()));
-  if (!LS) return setup_error("SUNLinSol_Dense");
+  // Newton systems by Eigen's LU (eigen_linear_solver.hpp says why not SUNLinSol_Dense).
+  detail::LinearSolverPtr LS(
+      detail::make_eigen_dense_solver(static_cast<sunindextype>(n), ctx.get()));
+  if (!LS) return setup_error("make_eigen_dense_solver");
   detail::CvodeMemPtr mem_owner(CVodeCreate(CV_BDF, ctx.get()));
   void* mem = mem_owner.get();
   if (!mem) return setup_error("CVodeCreate");
@@ -501,6 +519,12 @@ SimulationResult integrate(System& sys, const Eigen::VectorXd& x0,
         CVodeSetJacFn(mem, &detail::jacobian_callback<System>) != CVLS_SUCCESS)
       return setup_error("CVodeSetJacFn");
   }
+  if (opt.jacobian_max_age > 0 &&
+      CVodeSetJacEvalFrequency(mem, opt.jacobian_max_age) != CVLS_SUCCESS)
+    return setup_error("CVodeSetJacEvalFrequency");
+  if (opt.newton_matrix_max_age > 0 &&
+      CVodeSetLSetupFrequency(mem, opt.newton_matrix_max_age) != CV_SUCCESS)
+    return setup_error("CVodeSetLSetupFrequency");
   if (CVodeSetMaxOrd(mem, std::clamp(opt.max_order, 1, 5)) != CV_SUCCESS)
     return setup_error("CVodeSetMaxOrd");
   if (opt.max_step > 0 && CVodeSetMaxStep(mem, opt.max_step) != CV_SUCCESS)
