@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
         softrne::io::read_dataset(data_path, robot, /*require_angles=*/false);
 
     // 3. Simulate from rest at the first measured configuration (zero if none is given).
-    //    Defaults: CVODE BDF, rtol 1e-6, atol 1e-4 rad (1e-2 rad/s), PCHIP pressures.
+    //    Defaults: CVODE BDF, rtol 1e-6, atol 1e-5 rad (1e-2 rad/s), PCHIP pressures.
     const Eigen::VectorXd q0 = data.has_angles ? Eigen::VectorXd(data.angles.row(0).transpose())
                                                : Eigen::VectorXd::Zero(arm.nq);
     softrne::sim::ArmSimulationOptions options;

@@ -948,7 +948,7 @@ NB_MODULE(_softrne, m) {
       "pressures (N, num_pressures) on the time grid t (N,), with CVODE exactly as softrne-sim does "
       "(BDF, AutoDiff Jacobian, pchip interpolation of the pressures, restarts at pressure jumps). "
       "Returns the measured-space angles, shape (N, nq).\n\nSolver options (softrne-sim's, same "
-      "defaults): rtol (1e-6), atol (1e-4 rad), atol_velocity (100 atol), interpolation ('pchip', "
+      "defaults): rtol (1e-6), atol (1e-5 rad), atol_velocity (1000 atol = 1e-2 rad/s), interpolation ('pchip', "
       "'linear', 'zoh'), smooth (seconds of Gaussian pre-smoothing; off), jacobian ('ad', "
       "'ad-forward', 'fd'), max_steps (max(1e5, 1e4 per s)), max_wall_seconds. Raises "
       "SimulationError if the integration fails.");

@@ -60,11 +60,14 @@ struct ArmFitOptions {
   /// instead of 7.4k steps) for no change: the closed loop on random arm 1001 took 85.6 s
   /// instead of 53.9 s with the same decisions and held-out gains to 0.1 %. Effects with a
   /// sharp feature tighten it for the models that hold them (simulate_dataset).
-  /// \return rtol 1e-6, atol 1e-5, at most 60 s per simulation.
+  /// The velocities keep 1e-3 rad/s (velocity factor 100, tighter than the simulator's
+  /// default 1e-2): the loop's decisions and scores were measured with it.
+  /// \return rtol 1e-6, atol 1e-5 (1e-3 rad/s on the velocities), at most 60 s per simulation.
   static sim::ArmSimulationOptions default_simulation() {
     sim::ArmSimulationOptions s;
     s.cvode.rtol = 1e-6;
     s.cvode.atol = 1e-5;
+    s.velocity_atol_factor = 100;
     s.cvode.max_wall_seconds = 60;
     return s;
   }

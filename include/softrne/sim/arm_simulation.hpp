@@ -4,13 +4,15 @@
 ///
 /// Tolerances. The state is x = [q, qdot, effect states]. CVODE's absolute tolerance
 /// `cvode.atol` applies to the angles q (rad) and the effect states; the velocities get
-/// `cvode.atol * velocity_atol_factor` (rad/s). The defaults (rtol 1e-6, atol 1e-4 rad,
-/// velocities 1e-2 rad/s) keep the simulated angles within about 5e-4 rad of the converged
-/// solution on the bundled arm (examples/data/arm-a-1/test.csv, 14 s), six times below the
-/// angle sensors' noise (3e-3 rad) and far below the model error (0.1 rad), while not
-/// resolving the 1e-5 rad, 3e-3 rad/s wiggles that the 300 Pa sensor noise of recorded
-/// pressures drives at 50-100 Hz: at atol 1e-8 those cost 14 times the steps (34k instead of
-/// 2.5k). Tighten them for verification (tools/softrne-sim --help).
+/// `cvode.atol * velocity_atol_factor` (rad/s). The defaults (rtol 1e-6, atol 1e-5 rad,
+/// velocities 1e-2 rad/s) keep the simulated angles within 0.25 mrad of the converged solution
+/// (rtol 1e-10) on the bundled arm (examples/data/arm-a-1/test.csv, 14 s: 0.12 mrad) and on the
+/// test runs of eight random arms (softrne-make-case --seed 1001..1008 --none, simulated with
+/// their truth: at most 0.23 mrad), ten times below the angle sensors' noise (3e-3 rad). The
+/// velocities' tolerance is the looser one on purpose: the 300 Pa sensor noise of recorded
+/// pressures drives 1e-5 rad, 3e-3 rad/s wiggles at 50-100 Hz, and resolving them in the rates
+/// sets the step size (1e-3 rad/s instead of 1e-2 costs 40 % more steps for the same angles;
+/// docs/performance.md has the grid). Tighten both for verification (tools/softrne-sim --help).
 
 #include <algorithm>
 #include <chrono>
@@ -46,7 +48,7 @@ using signals::smooth_pressures;
 
 /// \brief Settings of simulate_arm.
 struct ArmSimulationOptions {
-  /// Integrator settings. Defaults here: rtol 1e-6, atol 1e-4 (rad, for the angles; see the
+  /// Integrator settings. Defaults here: rtol 1e-6, atol 1e-5 (rad, for the angles; see the
   /// file comment), CvodeOptions' defaults otherwise.
   CvodeOptions cvode = default_cvode();
   /// How recorded pressures are read between samples (see PressureInterpolation).
@@ -63,7 +65,7 @@ struct ArmSimulationOptions {
   /// Absolute tolerance of the velocities = cvode.atol * velocity_atol_factor (1/s): a
   /// velocity error dv moves the angles by about dv / omega for a mode of frequency omega.
   /// 1 gives every state the same atol.
-  double velocity_atol_factor = 100.0;
+  double velocity_atol_factor = 1000.0;
   /// OPTIONAL input pre-smoothing, off (0) by default: the standard deviation (s) of a
   /// Gaussian kernel applied to the recorded pressures before they are interpolated
   /// (smooth_pressures). It changes the model's input (and so the result): it removes sensor
@@ -74,11 +76,11 @@ struct ArmSimulationOptions {
   /// for progress indicators. Empty: never.
   std::function<void(double t)> progress;
 
-  /// \return CvodeOptions with rtol 1e-6 and atol 1e-4 (the defaults of `cvode`).
+  /// \return CvodeOptions with rtol 1e-6 and atol 1e-5 (the defaults of `cvode`).
   static CvodeOptions default_cvode() {
     CvodeOptions c;
     c.rtol = 1e-6;
-    c.atol = 1e-4;
+    c.atol = 1e-5;
     return c;
   }
 };
