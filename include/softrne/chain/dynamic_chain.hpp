@@ -118,6 +118,17 @@ class DynamicChain {
     for (int i = num_segments() - 1; i >= 0; --i) visit(data, f, i);
   }
 
+  /// \brief Calls f(segment, kinematics, index, q_offset) for segment i alone.
+  /// \param[in,out] data The workspace whose segment-i kinematics f receives.
+  /// \param[in] i The segment's index, 0 <= i < num_segments().
+  /// \param[in] f A generic callable (the segment is visited with its own type).
+  /// \throws std::invalid_argument if data was made for another chain.
+  template <class F>
+  void visit_segment(Data& data, int i, F&& f) const {
+    check_data(data);
+    visit(data, f, i);
+  }
+
   /// \brief The same chain in another scalar type (e.g. an AutoDiff scalar for derivatives).
   /// \tparam NewScalar The new scalar type.
   /// \return A copy with every constant converted.

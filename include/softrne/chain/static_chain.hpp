@@ -104,6 +104,15 @@ class Chain {
   /// \brief The same chain in another scalar type (e.g. an AutoDiff scalar for derivatives).
   /// \tparam NewScalar The new scalar type.
   /// \return A Chain of the converted segments.
+  /// \brief Calls f(segment, kinematics, index, q_offset) for segment i alone.
+  /// \param[in,out] data The workspace whose segment-i kinematics f receives.
+  /// \param[in] i The segment's index, 0 <= i < num_segments.
+  /// \param[in] f A generic callable, as for forward().
+  template <class DataT, class F>
+  void visit_segment(DataT& data, int i, F&& f) const {
+    visit_one(data, i, f, std::index_sequence_for<Segments...>{});
+  }
+
   template <class NewScalar>
   auto cast() const {
     return cast_impl<NewScalar>(std::index_sequence_for<Segments...>{});
@@ -121,6 +130,10 @@ class Chain {
   template <class DataT, class F, std::size_t... I>
   void backward_impl(DataT& data, F& f, std::index_sequence<I...>) const {
     (visit<sizeof...(Segments) - 1 - I>(data, f), ...);
+  }
+  template <class DataT, class F, std::size_t... I>
+  void visit_one(DataT& data, int i, F& f, std::index_sequence<I...>) const {
+    ((static_cast<int>(I) == i ? visit<I>(data, f) : void()), ...);
   }
   template <class NewScalar, std::size_t... I>
   auto cast_impl(std::index_sequence<I...>) const {
