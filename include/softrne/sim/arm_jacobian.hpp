@@ -11,7 +11,7 @@
 #include <unsupported/Eigen/AutoDiff>
 
 #include "softrne/config.hpp"
-#include "softrne/algorithms/rnea.hpp"
+#include "softrne/algorithms/derivatives.hpp"
 #include "softrne/arm/arm_dynamics.hpp"
 #include "softrne/chain/derivative_workspace.hpp"
 
@@ -21,10 +21,11 @@ namespace softrne::sim {
 /// - inverse_dynamics: \f$\partial\ddot q/\partial x = M^{-1}(\partial\tau/\partial x -
 ///   \partial\,\mathrm{ID}(q,\dot q,\ddot q^*)/\partial x)\f$ at the current acceleration
 ///   \f$\ddot q^*\f$, with ID the chain's RNE (M qddot + C qdot + G) and tau every other
-///   force (pressures, springs, dampers, effects). AutoDiff runs through one kinematics pass
-///   and one RNE pass per block; M's Cholesky factor comes from a double evaluation. 1.3 to
-///   2 times cheaper than differentiating forward dynamics (the default). The pressures and
-///   the effect states do not enter ID, so their columns need no RNE pass.
+///   force (pressures, springs, dampers, effects). \f$\partial\mathrm{ID}/\partial(q,\dot q)\f$
+///   comes from the core's derivatives (algorithms/derivatives.hpp, once per Jacobian), tau's
+///   from AutoDiff through ArmDynamics::joint_forces per block, M's Cholesky factor from a
+///   double evaluation. The cheaper method (the default). The pressures and the effect states
+///   do not enter ID.
 /// - forward_dynamics: AutoDiff through the whole right-hand side (kinematics, nq + 1 RNE
 ///   passes, Cholesky).
 enum class JacobianMethod { inverse_dynamics, forward_dynamics };
@@ -115,7 +116,8 @@ class ArmJacobian {
   const ArmDescription& desc_;
   ArmDynamics<double> f_;
   ArmDynamics<AD> f_ad_;
-  ADVector x_ad_, xd_ad_, q_ad_, v_ad_, a_ad_, p_ad_, pin_ad_;
+  DynamicChainData<double> id_data_;  // the derivatives of ID (inverse_dynamics)
+  ADVector x_ad_, xd_ad_, q_ad_, v_ad_, p_ad_, pin_ad_;
   Eigen::VectorXd xdot_;
   Eigen::Matrix<double, Eigen::Dynamic, kBlock> dr_;
   JacobianMethod method_ = JacobianMethod::inverse_dynamics;
@@ -125,13 +127,12 @@ class ArmJacobian {
 // Compiled once in src/sim.cpp for the targets that link softrne::sim_compiled, inline
 // otherwise (config.hpp), like ArmSystem's members.
 SOFTRNE_SIM_INLINE ArmJacobian::ArmJacobian(const ArmDescription& desc)
-    : desc_(desc), f_(desc), f_ad_(desc) {
+    : desc_(desc), f_(desc), f_ad_(desc), id_data_(f_.chain().make_data()) {
   const int nq = desc.nq, ns = desc.num_states(), m = desc.num_inputs;
   x_ad_.resize(ns);
   xd_ad_.resize(ns);
   q_ad_.resize(nq);
   v_ad_.resize(nq);
-  a_ad_.resize(nq);
   p_ad_.resize(m);
   pin_ad_.resize(m);
   xdot_.resize(ns);
@@ -171,14 +172,13 @@ SOFTRNE_SIM_INLINE bool ArmJacobian::differentiate(const Eigen::Ref<const Eigen:
                                                    Eigen::Ref<Eigen::MatrixXd>* B) {
   const int n = num_states();
   if (method_ == JacobianMethod::inverse_dynamics) {
-    // Double evaluation: the acceleration qddot* and M's Cholesky factor at (x, p).
+    // Double evaluation: the acceleration qddot* and M's Cholesky factor at (x, p), then
+    // d ID / d(q, qdot) at qddot*.
     f_.rhs(x, p, xdot_);
     if (!xdot_.allFinite()) return false;
-    const auto& qdd = f_.data().qddot;
-    for (int i = 0; i < desc_.nq; ++i) {
-      a_ad_(i).value() = qdd(i);
-      a_ad_(i).derivatives().setZero();
-    }
+    const int nq = desc_.nq;
+    detail::rnea_derivative_passes(f_.chain(), id_data_, x.head(nq), x.segment(nq, nq),
+                                   f_.data().qddot);
   }
   for (int start = 0; start < ncols; start += kBlock) {
     seed(x, p, start);
@@ -225,10 +225,12 @@ void ArmJacobian::inverse(const P& p, int start, int ncols, Eigen::Ref<Eigen::Ma
   const auto& tau = f_ad_.joint_forces(q_ad_, v_ad_, p_ad_, xs);
   for (int i = 0; i < nq; ++i)
     for (int k = 0; k < kBlock; ++k) dr_(i, k) = tau(i).derivatives()(k);
-  if (start < 2 * nq) {  // ID depends on q and qdot only
-    const auto& id = rnea(f_ad_.chain(), f_ad_.data(), q_ad_, v_ad_, a_ad_);
-    for (int i = 0; i < nq; ++i)
-      for (int k = 0; k < kBlock; ++k) dr_(i, k) -= id(i).derivatives()(k);
+  for (int k = 0; k < cols; ++k) {  // ID depends on q and qdot only
+    const int c = start + k;
+    if (c < nq)
+      dr_.col(k) -= id_data_.dtau_dq.col(c);
+    else if (c < 2 * nq)
+      dr_.col(k) -= id_data_.dtau_dqdot.col(c - nq);
   }
   L.triangularView<Eigen::Lower>().solveInPlace(dr_);
   L.transpose().triangularView<Eigen::Upper>().solveInPlace(dr_);
