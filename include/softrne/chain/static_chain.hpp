@@ -101,9 +101,6 @@ class Chain {
     backward_impl(data, f, std::index_sequence_for<Segments...>{});
   }
 
-  /// \brief The same chain in another scalar type (e.g. an AutoDiff scalar for derivatives).
-  /// \tparam NewScalar The new scalar type.
-  /// \return A Chain of the converted segments.
   /// \brief Calls f(segment, kinematics, index, q_offset) for segment i alone.
   /// \param[in,out] data The workspace whose segment-i kinematics f receives.
   /// \param[in] i The segment's index, 0 <= i < num_segments.
@@ -113,6 +110,9 @@ class Chain {
     visit_one(data, i, f, std::index_sequence_for<Segments...>{});
   }
 
+  /// \brief The same chain in another scalar type (e.g. an AutoDiff scalar for derivatives).
+  /// \tparam NewScalar The new scalar type.
+  /// \return A Chain of the converted segments.
   template <class NewScalar>
   auto cast() const {
     return cast_impl<NewScalar>(std::index_sequence_for<Segments...>{});
