@@ -17,8 +17,8 @@
 /// - **every segment**: the wrench's derivatives come back base-wards, through s in AutoDiff
 ///   and through the segments before s as a pure transmission (their loads do not move).
 /// So nq blocks cost nq AutoDiff evaluations of one segment plus O(n) double tangent steps
-/// each, against nq AutoDiff passes of the whole RNE before (28x rnea on the paper's arm;
-/// docs/performance.md has both). Still exact to rounding (no step size), at phi = 0 and
+/// each, against nq AutoDiff passes of the whole RNE before (28-35x rnea on the paper's arm;
+/// now 18x, docs/performance.md has both). Still exact to rounding (no step size), at phi = 0 and
 /// across the series switches, for every segment type (a new one is differentiated as soon as
 /// it has calc: the tangent steps read only the fields every segment's kinematics have).
 /// Analytical recursions for the CC joint itself (Pinocchio's computeRNEADerivatives has them
