@@ -6,9 +6,10 @@
 /// (derivatives.hpp).
 ///
 /// A block of kDerivativeBlock directions is a 3 x kDerivativeBlock matrix per vector
-/// (column k: the derivative along direction k; the types are in derivative_workspace.hpp). Derived from forward_step and backward_step
-/// term by term (product rule on eqs. 11-18 with the base motion and the children's wrench as
-/// the only variables; the velocity products are bilinear, the rest linear):
+/// (column k: the derivative along direction k; the types are in derivative_workspace.hpp).
+/// Derived from forward_step and backward_step term by term (product rule on eqs. 11-18 with
+/// the base motion and the children's wrench as the only variables; the velocity products are
+/// quadratic in the base's omega, everything else linear):
 /// - forward: \f$\delta\omega_e = \delta\omega\f$,
 ///   \f$\delta\alpha_e = \delta\alpha + \delta\omega\times\omega_{rel}\f$,
 ///   \f$\delta a_e = \delta a + \delta\alpha\times r + \delta\omega\times(\omega\times r) +
