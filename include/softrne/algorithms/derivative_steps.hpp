@@ -30,16 +30,10 @@
 
 #include "softrne/algorithms/rnea_steps.hpp"
 #include "softrne/chain/derivative_workspace.hpp"
+#include "softrne/spatial/skew.hpp"
 
 namespace softrne {
 namespace detail {
-
-/// \brief \f$[v]_\times\f$: skew(v) * w = v x w.
-EIGEN_ALWAYS_INLINE Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d s;
-  s << 0, -v(2), v(1), v(2), 0, -v(0), -v(1), v(0), 0;
-  return s;
-}
 
 /// \brief \f$\partial/\partial\omega\f$ of \f$\omega\times(\omega\times r) + 2\omega\times v\f$
 /// at \f$\omega\f$ (the velocity-product terms of a point's acceleration, eqs. 14-15):
@@ -48,7 +42,8 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
 EIGEN_ALWAYS_INLINE Eigen::Matrix3d point_velocity_terms_jacobian(const Eigen::Vector3d& w,
                                                                   const Eigen::Vector3d& r,
                                                                   const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m = -skew(w.cross(r) + 2.0 * v);
+  const Eigen::Vector3d c = w.cross(r) + 2.0 * v;
+  Eigen::Matrix3d m = -skew(c);
   m.noalias() -= r * w.transpose();
   m.diagonal().array() += w.dot(r);
   return m;
@@ -105,7 +100,8 @@ void forward_tangent_step(const Segment& seg, const typename Segment::Kinematics
     const Vector3 omega = w + w_rel;
     const Vector3 w_d = turns ? Vector3(kin.R_base_distal.transpose() * omega) : omega;
     const auto& I = kin.inertia_com;
-    Eigen::Matrix3d K = skew(w_d) * I - skew(I * w_d);
+    const Vector3 h = I * w_d;  // the angular momentum, evaluated once
+    Eigen::Matrix3d K = skew(w_d) * I - skew(h);
     if constexpr (nq > 0)
       if (inertia_rate == InertiaRate::Consistent) K += kin.inertia_rate;
     Tangent3 torque = I * d_distal.alpha;
@@ -128,7 +124,8 @@ void forward_tangent_step(const Segment& seg, const typename Segment::Kinematics
       acc_b.noalias() -= skew(r) * d_base.alpha;
       acc_b.noalias() += point_velocity_terms_jacobian(w, r, v_rel_b) * d_base.omega;
       Tangent3 torque_b = b.inertia * alpha_b;
-      torque_b.noalias() += (skew(omega_b) * b.inertia - skew(b.inertia * omega_b)) * d_base.omega;
+      const Vector3 h_b = b.inertia * omega_b;
+      torque_b.noalias() += (skew(omega_b) * b.inertia - skew(h_b)) * d_base.omega;
       const Tangent3 f = b.mass * acc_b;
       d_load.force += f;
       d_load.torque += torque_b;

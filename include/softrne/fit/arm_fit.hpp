@@ -27,6 +27,7 @@
 // names (softrne::ErrorStats, ...): user code that included only the fit headers names them so.
 #include "softrne/model/error_stats.hpp"
 #include "softrne/sim/arm_simulation.hpp"
+#include "softrne/spatial/skew.hpp"
 
 namespace softrne::fit {
 
@@ -405,9 +406,7 @@ inline std::vector<Eigen::VectorXd> capture_frame_std_errors(
       const Eigen::Index at = static_cast<Eigen::Index>(i) * (na + nm) + na + k;
       const Eigen::Vector3d Rx =
           y.row(rows[i]).segment<3>(k).transpose() - out.capture_frames[static_cast<std::size_t>(g)].t;
-      Eigen::Matrix3d skew;
-      skew << 0, -Rx(2), Rx(1), Rx(2), 0, -Rx(0), -Rx(1), Rx(0), 0;
-      J.block<3, 3>(at, col) = -scale * marker_weight * skew;
+      J.block<3, 3>(at, col) = -scale * marker_weight * skew(Rx);
       J.block<3, 3>(at, col + 3) = scale * marker_weight * Eigen::Matrix3d::Identity();
     }
   }

@@ -11,7 +11,8 @@ namespace softrne {
 /// \param[in] w A 3-vector.
 /// \return The 3x3 skew-symmetric matrix of w.
 template <class Derived>
-Eigen::Matrix<typename Derived::Scalar, 3, 3> skew(const Eigen::MatrixBase<Derived>& w) {
+EIGEN_ALWAYS_INLINE Eigen::Matrix<typename Derived::Scalar, 3, 3> skew(
+    const Eigen::MatrixBase<Derived>& w) {
   using S = typename Derived::Scalar;
   Eigen::Matrix<S, 3, 3> m;
   m << S(0), -w(2), w(1), w(2), S(0), -w(0), -w(1), w(0), S(0);
