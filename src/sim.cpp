@@ -4,6 +4,8 @@
 #define SOFTRNE_COMPILING_SIM
 #include "softrne/arm/arm_description.hpp"
 #include "softrne/arm/arm_dynamics.hpp"
+#include "softrne/arm/equilibrium.hpp"
+#include "softrne/arm/markers.hpp"
 #include "softrne/sim/arm_simulation.hpp"
 #include "softrne/sim/arm_jacobian.hpp"
 #include "softrne/sim/closed_loop.hpp"

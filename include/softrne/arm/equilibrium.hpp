@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "softrne/config.hpp"
 #include "softrne/arm/arm_description.hpp"
 #include "softrne/arm/arm_dynamics.hpp"
 
@@ -24,8 +25,10 @@ namespace softrne {
 /// \param[in] q Starting guess (nq), or empty for the straight arm.
 /// \return The coordinates (not the measured angles), rad.
 /// \throws std::runtime_error if the accelerations are not below 1e-7 rad/s^2 after 200 steps.
-inline Eigen::VectorXd static_equilibrium(const ArmDescription& d, const Eigen::VectorXd& p,
-                                          Eigen::VectorXd q = Eigen::VectorXd()) {
+SOFTRNE_SIM_INLINE Eigen::VectorXd static_equilibrium(const ArmDescription& d, const Eigen::VectorXd& p,
+                                                      Eigen::VectorXd q = Eigen::VectorXd())
+#if SOFTRNE_SIM_BODIES
+{
   using Vec = Eigen::VectorXd;
   ArmDynamics<double> f(d);
   const int n = d.nq;
@@ -63,5 +66,8 @@ inline Eigen::VectorXd static_equilibrium(const ArmDescription& d, const Eigen::
                              std::to_string(r.lpNorm<Eigen::Infinity>()) + " rad/s^2)");
   return q;
 }
+#else
+;
+#endif
 
 }  // namespace softrne

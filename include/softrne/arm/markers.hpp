@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
+#include "softrne/config.hpp"
 #include "softrne/algorithms/kinematics.hpp"
 #include "softrne/arm/arm_description.hpp"
 
@@ -54,7 +55,9 @@ inline double arm_reach(const ArmDescription& d) {
 /// \param[in] d The arm (d.spec.markers).
 /// \param[in] states N x (at least nq).
 /// \return N x 3M, columns x, y, z of each marker in order, m.
-inline Eigen::MatrixXd marker_positions(const ArmDescription& d, const Eigen::MatrixXd& states) {
+SOFTRNE_SIM_INLINE Eigen::MatrixXd marker_positions(const ArmDescription& d, const Eigen::MatrixXd& states)
+#if SOFTRNE_SIM_BODIES
+{
   const std::vector<int> seg = marker_segments(d);
   const auto M = static_cast<Eigen::Index>(seg.size());
   Eigen::MatrixXd out(states.rows(), 3 * M);
@@ -72,6 +75,9 @@ inline Eigen::MatrixXd marker_positions(const ArmDescription& d, const Eigen::Ma
   }
   return out;
 }
+#else
+;
+#endif
 
 /// \brief A rigid transform from the arm's base frame to the motion-capture frame:
 /// y = R x + t.
@@ -102,8 +108,10 @@ struct CaptureFrame {
 /// \param[in] use Rows to use (size N), or empty for all.
 /// \return The frame; identity rotation if the points do not determine it (fewer than three
 ///   non-collinear points are only as good as they are: the SVD picks one).
-inline CaptureFrame fit_capture_frame(const Eigen::MatrixXd& base, const Eigen::MatrixXd& measured,
-                                      const std::vector<bool>& use = {}) {
+SOFTRNE_SIM_INLINE CaptureFrame fit_capture_frame(const Eigen::MatrixXd& base, const Eigen::MatrixXd& measured,
+                                                  const std::vector<bool>& use = {})
+#if SOFTRNE_SIM_BODIES
+{
   CaptureFrame f;
   Eigen::Vector3d cb = Eigen::Vector3d::Zero(), cm = Eigen::Vector3d::Zero();
   double n = 0;
@@ -131,5 +139,8 @@ inline CaptureFrame fit_capture_frame(const Eigen::MatrixXd& base, const Eigen::
   f.t = cm - f.R * cb;
   return f;
 }
+#else
+;
+#endif
 
 }  // namespace softrne

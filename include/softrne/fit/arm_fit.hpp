@@ -265,7 +265,9 @@ SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d, 
 /// \param[in] d The arm.
 /// \param[in] data The data set.
 /// \throws std::invalid_argument if it has no angles, fewer than 20 samples or no motion.
-inline void check_fit_data(const ArmDescription& d, const io::Dataset& data) {
+SOFTRNE_FIT_INLINE void check_fit_data(const ArmDescription& d, const io::Dataset& data)
+#if SOFTRNE_FIT_BODIES
+{
   const bool markers = data.has_markers && !d.spec.markers.empty() &&
                        data.markers.cols() == 3 * static_cast<Eigen::Index>(d.spec.markers.size());
   if (!markers && (!data.has_angles || data.angles.cols() != d.nq))
@@ -282,6 +284,9 @@ inline void check_fit_data(const ArmDescription& d, const io::Dataset& data) {
                                 ": the pressures are constant and the arm does not move: stiffness and "
                                 "damping are not identifiable from it");
 }
+#else
+;
+#endif
 
 namespace detail {
 
@@ -299,8 +304,10 @@ inline std::vector<int> frame_of_rows(const io::Dataset& data, bool per_recordin
 
 /// The capture frames that best map `base` (N x 3M, base frame) onto data.markers on the rows of
 /// `use` (all if empty), one per group of frame_of_rows().
-inline std::vector<CaptureFrame> fit_capture_frames(const Eigen::MatrixXd& base, const io::Dataset& data,
-                                                    const std::vector<int>& group, const std::vector<bool>& use) {
+SOFTRNE_FIT_INLINE std::vector<CaptureFrame> fit_capture_frames(const Eigen::MatrixXd& base, const io::Dataset& data,
+                                                                const std::vector<int>& group, const std::vector<bool>& use)
+#if SOFTRNE_FIT_BODIES
+{
   const int G = group.empty() ? 0 : *std::max_element(group.begin(), group.end()) + 1;
   std::vector<CaptureFrame> frames(static_cast<std::size_t>(G));
   for (int g = 0; g < G; ++g) {
@@ -310,26 +317,36 @@ inline std::vector<CaptureFrame> fit_capture_frames(const Eigen::MatrixXd& base,
   }
   return frames;
 }
+#else
+;
+#endif
 
 /// Base-frame positions mapped into each row's capture frame.
-inline Eigen::MatrixXd in_capture_frames(const Eigen::MatrixXd& base, const std::vector<CaptureFrame>& frames,
-                                         const std::vector<int>& group) {
+SOFTRNE_FIT_INLINE Eigen::MatrixXd in_capture_frames(const Eigen::MatrixXd& base, const std::vector<CaptureFrame>& frames,
+                                                     const std::vector<int>& group)
+#if SOFTRNE_FIT_BODIES
+{
   Eigen::MatrixXd y(base.rows(), base.cols());
   for (Eigen::Index i = 0; i < base.rows(); ++i)
     y.row(i) = frames[static_cast<std::size_t>(group[static_cast<std::size_t>(i)])].apply(base.row(i));
   return y;
 }
+#else
+;
+#endif
 
 /// The fit's residual of one simulation `s` of arm `d`: for each row of `rows`, the nq angle
 /// errors (data with angles), then the 3M marker errors in the row's capture frame times
 /// `marker_weight` (data with markers, marker_weight > 0); all times `scale`. The frames are
 /// `fixed` if given, else solved for this simulation on the rows of `mask` (fit_capture_frames)
 /// and returned in `frames`.
-inline void fit_residual(const ArmDescription& d, const sim::ArmSimulation& s, const io::Dataset& data,
-                         const std::vector<Eigen::Index>& rows, const std::vector<bool>& mask, double scale,
-                         double marker_weight, const std::vector<int>& group,
-                         const std::vector<CaptureFrame>* fixed, std::vector<CaptureFrame>* frames,
-                         Eigen::VectorXd& r) {
+SOFTRNE_FIT_INLINE void fit_residual(const ArmDescription& d, const sim::ArmSimulation& s, const io::Dataset& data,
+                                     const std::vector<Eigen::Index>& rows, const std::vector<bool>& mask, double scale,
+                                     double marker_weight, const std::vector<int>& group,
+                                     const std::vector<CaptureFrame>* fixed, std::vector<CaptureFrame>* frames,
+                                     Eigen::VectorXd& r)
+#if SOFTRNE_FIT_BODIES
+{
   const Eigen::Index na = data.has_angles ? d.nq : 0;
   const Eigen::Index nm = marker_weight > 0 && data.has_markers ? data.markers.cols() : 0;
   r.resize(static_cast<Eigen::Index>(rows.size()) * (na + nm));
@@ -346,10 +363,15 @@ inline void fit_residual(const ArmDescription& d, const sim::ArmSimulation& s, c
     if (nm > 0) r.segment(at + na, nm) = scale * marker_weight * (y.row(row) - data.markers.row(row)).transpose();
   }
 }
+#else
+;
+#endif
 
 /// Per marker, the distance between simulated (capture frame) and measured positions, mm.
-inline signals::ErrorStats marker_error_stats(const ArmDescription& d, const Eigen::MatrixXd& simulated,
-                                              const Eigen::MatrixXd& measured) {
+SOFTRNE_FIT_INLINE signals::ErrorStats marker_error_stats(const ArmDescription& d, const Eigen::MatrixXd& simulated,
+                                                          const Eigen::MatrixXd& measured)
+#if SOFTRNE_FIT_BODIES
+{
   const auto M = static_cast<Eigen::Index>(d.spec.markers.size());
   Eigen::MatrixXd dist(simulated.rows(), M);
   std::vector<std::string> names;
@@ -360,6 +382,9 @@ inline signals::ErrorStats marker_error_stats(const ArmDescription& d, const Eig
   }
   return signals::error_stats(dist, Eigen::MatrixXd::Zero(dist.rows(), M), names);
 }
+#else
+;
+#endif
 
 /// Standard errors of the fitted capture frames (per frame: 3 rotation angles about the capture
 /// axes, rad, then 3 translations, m) from the Jacobian of the whole residual at the optimum in
@@ -368,10 +393,12 @@ inline signals::ErrorStats marker_error_stats(const ArmDescription& d, const Eig
 /// itself): covariance s^2 (J^T J)^+ with s^2 = |r|^2 / (m - n). The fit's own standard errors
 /// of the physical parameters come from the residual with the frames solved (projected), which
 /// is the same marginal covariance.
-inline std::vector<Eigen::VectorXd> capture_frame_std_errors(
-    const ArmFitResult& out, const std::vector<ParamSlot>& slots, const ArmDescription& start,
-    const io::Dataset& data, const std::vector<Eigen::Index>& rows, const ArmFitOptions& opt, double scale,
-    double marker_weight, const std::vector<int>& group, const Eigen::VectorXd& r0, std::atomic<int>& sims) {
+SOFTRNE_FIT_INLINE std::vector<Eigen::VectorXd> capture_frame_std_errors(
+                const ArmFitResult& out, const std::vector<ParamSlot>& slots, const ArmDescription& start,
+                const io::Dataset& data, const std::vector<Eigen::Index>& rows, const ArmFitOptions& opt, double scale,
+                double marker_weight, const std::vector<int>& group, const Eigen::VectorXd& r0, std::atomic<int>& sims)
+#if SOFTRNE_FIT_BODIES
+{
   const int np = out.fit.params.size() == out.parameters.size() ? out.parameters.size() : 0;
   const auto G = static_cast<Eigen::Index>(out.capture_frames.size());
   const Eigen::Index m = r0.size();
@@ -418,6 +445,9 @@ inline std::vector<Eigen::VectorXd> capture_frame_std_errors(
     out_se.push_back(cov.diagonal().segment(np + 6 * g, 6).cwiseMax(0.0).cwiseSqrt());
   return out_se;
 }
+#else
+;
+#endif
 
 }  // namespace detail
 
@@ -435,9 +465,11 @@ inline std::vector<Eigen::VectorXd> capture_frame_std_errors(
 /// \param[in] frames The frames to measure in (one shared), or null to fit them.
 /// \param[out] fitted The frames used, if not null.
 /// \return The statistics; empty if the simulation failed or the data have no markers.
-inline signals::ErrorStats marker_errors(const ArmDescription& d, const io::Dataset& data, const sim::ArmSimulation& s,
-                                         bool per_recording, const std::vector<CaptureFrame>* frames,
-                                         std::vector<CaptureFrame>* fitted = nullptr) {
+SOFTRNE_FIT_INLINE signals::ErrorStats marker_errors(const ArmDescription& d, const io::Dataset& data, const sim::ArmSimulation& s,
+                                                     bool per_recording, const std::vector<CaptureFrame>* frames,
+                                                     std::vector<CaptureFrame>* fitted = nullptr)
+#if SOFTRNE_FIT_BODIES
+{
   if (!data.has_markers || d.spec.markers.empty()) return {};
   if (!s.ok() || s.states.rows() != data.t.size()) return {};
   const Eigen::MatrixXd base = marker_positions(d, s.states);
@@ -447,6 +479,9 @@ inline signals::ErrorStats marker_errors(const ArmDescription& d, const io::Data
   if (fitted) *fitted = f;
   return detail::marker_error_stats(d, detail::in_capture_frames(base, f, group), data.markers);
 }
+#else
+;
+#endif
 
 /// \brief Fits the free parameters of `start` to the measured angles of `data`, minimising the
 /// simulation error (the model is simulated from the first sample with the recorded pressures,
