@@ -21,6 +21,8 @@
 #include <sundials/sundials_linearsolver.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include "softrne/config.hpp"
+
 namespace softrne::sim::detail {
 
 /// \brief The solver's state: the factor of the last setup.
@@ -39,7 +41,9 @@ inline EigenDenseLuContent& eigen_lu_content(SUNLinearSolver S) {
 /// \param[in] n The system size.
 /// \param[in] ctx The SUNDIALS context.
 /// \return The solver (free it with SUNLinSolFree), or null if SUNDIALS could not allocate.
-inline SUNLinearSolver make_eigen_dense_solver(sunindextype n, SUNContext ctx) {
+SOFTRNE_SIM_INLINE SUNLinearSolver make_eigen_dense_solver(sunindextype n, SUNContext ctx)
+#if SOFTRNE_SIM_BODIES
+{
   SUNLinearSolver S = SUNLinSolNewEmpty(ctx);
   if (!S) return nullptr;
   S->content = new EigenDenseLuContent(static_cast<Eigen::Index>(n));
@@ -106,5 +110,8 @@ inline SUNLinearSolver make_eigen_dense_solver(sunindextype n, SUNContext ctx) {
   };
   return S;
 }
+#else
+;
+#endif
 
 }  // namespace softrne::sim::detail
