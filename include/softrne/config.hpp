@@ -39,6 +39,12 @@
 /// SOFTRNE_COMPILING_FIT) hold the one definition. The same idea as Pinocchio's explicit
 /// template instantiation library; the code is the same text in both modes.
 ///
+/// Not only entry points: any plain `inline` function whose body uses the dynamics, a runtime
+/// chain or a dynamic-size decomposition costs every unit that includes its header, called or
+/// not, since GCC instantiates the templates an inline body uses. Such helpers take this form
+/// too (static_equilibrium: 9 s of g++ front end per unit; fit/arm_fit.hpp's marker helpers
+/// about 15 s).
+///
 /// Usage at a definition:
 ///
 ///     SOFTRNE_FIT_INLINE FitResult fit_arm(...)
