@@ -25,7 +25,8 @@ namespace softrne {
 /// \param[in] q Starting guess (nq), or empty for the straight arm.
 /// \return The coordinates (not the measured angles), rad.
 /// \throws std::runtime_error if the accelerations are not below 1e-7 rad/s^2 after 200 steps.
-SOFTRNE_SIM_INLINE Eigen::VectorXd static_equilibrium(const ArmDescription& d, const Eigen::VectorXd& p,
+SOFTRNE_SIM_INLINE Eigen::VectorXd static_equilibrium(const ArmDescription& d,
+                                                      const Eigen::VectorXd& p,
                                                       Eigen::VectorXd q = Eigen::VectorXd())
 #if SOFTRNE_SIM_BODIES
 {

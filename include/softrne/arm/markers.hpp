@@ -55,7 +55,8 @@ inline double arm_reach(const ArmDescription& d) {
 /// \param[in] d The arm (d.spec.markers).
 /// \param[in] states N x (at least nq).
 /// \return N x 3M, columns x, y, z of each marker in order, m.
-SOFTRNE_SIM_INLINE Eigen::MatrixXd marker_positions(const ArmDescription& d, const Eigen::MatrixXd& states)
+SOFTRNE_SIM_INLINE Eigen::MatrixXd marker_positions(const ArmDescription& d,
+                                                    const Eigen::MatrixXd& states)
 #if SOFTRNE_SIM_BODIES
 {
   const std::vector<int> seg = marker_segments(d);
@@ -108,7 +109,8 @@ struct CaptureFrame {
 /// \param[in] use Rows to use (size N), or empty for all.
 /// \return The frame; identity rotation if the points do not determine it (fewer than three
 ///   non-collinear points are only as good as they are: the SVD picks one).
-SOFTRNE_SIM_INLINE CaptureFrame fit_capture_frame(const Eigen::MatrixXd& base, const Eigen::MatrixXd& measured,
+SOFTRNE_SIM_INLINE CaptureFrame fit_capture_frame(const Eigen::MatrixXd& base,
+                                                  const Eigen::MatrixXd& measured,
                                                   const std::vector<bool>& use = {})
 #if SOFTRNE_SIM_BODIES
 {

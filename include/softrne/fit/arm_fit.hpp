@@ -124,8 +124,8 @@ struct ParamSlot {
   int k;      // axis or effect parameter index
 };
 
-SOFTRNE_FIT_INLINE std::vector<ParamSlot> make_slots(const ArmDescription& d, const ArmFitOptions& o,
-                                                     ParameterSet& ps)
+SOFTRNE_FIT_INLINE std::vector<ParamSlot> make_slots(const ArmDescription& d,
+                                                     const ArmFitOptions& o, ParameterSet& ps)
 #if SOFTRNE_FIT_BODIES
 {
   std::vector<ParamSlot> slots;
@@ -209,7 +209,8 @@ SOFTRNE_FIT_INLINE void apply(const std::vector<ParamSlot>& slots, const Eigen::
 /// \param[in] data The data set (times, recorded pressures, measured angles).
 /// \param[in] opt The integrator settings.
 /// \return The simulation (result.ok false with a message if it failed).
-SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d, const io::Dataset& data,
+SOFTRNE_FIT_INLINE sim::ArmSimulation simulate_dataset(const ArmDescription& d,
+                                                       const io::Dataset& data,
                                                        const sim::ArmSimulationOptions& opt)
 #if SOFTRNE_FIT_BODIES
 {
@@ -304,8 +305,10 @@ inline std::vector<int> frame_of_rows(const io::Dataset& data, bool per_recordin
 
 /// The capture frames that best map `base` (N x 3M, base frame) onto data.markers on the rows of
 /// `use` (all if empty), one per group of frame_of_rows().
-SOFTRNE_FIT_INLINE std::vector<CaptureFrame> fit_capture_frames(const Eigen::MatrixXd& base, const io::Dataset& data,
-                                                                const std::vector<int>& group, const std::vector<bool>& use)
+SOFTRNE_FIT_INLINE std::vector<CaptureFrame> fit_capture_frames(const Eigen::MatrixXd& base,
+                                                                const io::Dataset& data,
+                                                                const std::vector<int>& group,
+                                                                const std::vector<bool>& use)
 #if SOFTRNE_FIT_BODIES
 {
   const int G = group.empty() ? 0 : *std::max_element(group.begin(), group.end()) + 1;
@@ -322,7 +325,8 @@ SOFTRNE_FIT_INLINE std::vector<CaptureFrame> fit_capture_frames(const Eigen::Mat
 #endif
 
 /// Base-frame positions mapped into each row's capture frame.
-SOFTRNE_FIT_INLINE Eigen::MatrixXd in_capture_frames(const Eigen::MatrixXd& base, const std::vector<CaptureFrame>& frames,
+SOFTRNE_FIT_INLINE Eigen::MatrixXd in_capture_frames(const Eigen::MatrixXd& base,
+                                                     const std::vector<CaptureFrame>& frames,
                                                      const std::vector<int>& group)
 #if SOFTRNE_FIT_BODIES
 {
@@ -340,11 +344,12 @@ SOFTRNE_FIT_INLINE Eigen::MatrixXd in_capture_frames(const Eigen::MatrixXd& base
 /// `marker_weight` (data with markers, marker_weight > 0); all times `scale`. The frames are
 /// `fixed` if given, else solved for this simulation on the rows of `mask` (fit_capture_frames)
 /// and returned in `frames`.
-SOFTRNE_FIT_INLINE void fit_residual(const ArmDescription& d, const sim::ArmSimulation& s, const io::Dataset& data,
-                                     const std::vector<Eigen::Index>& rows, const std::vector<bool>& mask, double scale,
+SOFTRNE_FIT_INLINE void fit_residual(const ArmDescription& d, const sim::ArmSimulation& s,
+                                     const io::Dataset& data, const std::vector<Eigen::Index>& rows,
+                                     const std::vector<bool>& mask, double scale,
                                      double marker_weight, const std::vector<int>& group,
-                                     const std::vector<CaptureFrame>* fixed, std::vector<CaptureFrame>* frames,
-                                     Eigen::VectorXd& r)
+                                     const std::vector<CaptureFrame>* fixed,
+                                     std::vector<CaptureFrame>* frames, Eigen::VectorXd& r)
 #if SOFTRNE_FIT_BODIES
 {
   const Eigen::Index na = data.has_angles ? d.nq : 0;
@@ -368,7 +373,8 @@ SOFTRNE_FIT_INLINE void fit_residual(const ArmDescription& d, const sim::ArmSimu
 #endif
 
 /// Per marker, the distance between simulated (capture frame) and measured positions, mm.
-SOFTRNE_FIT_INLINE signals::ErrorStats marker_error_stats(const ArmDescription& d, const Eigen::MatrixXd& simulated,
+SOFTRNE_FIT_INLINE signals::ErrorStats marker_error_stats(const ArmDescription& d,
+                                                          const Eigen::MatrixXd& simulated,
                                                           const Eigen::MatrixXd& measured)
 #if SOFTRNE_FIT_BODIES
 {
@@ -394,9 +400,10 @@ SOFTRNE_FIT_INLINE signals::ErrorStats marker_error_stats(const ArmDescription& 
 /// of the physical parameters come from the residual with the frames solved (projected), which
 /// is the same marginal covariance.
 SOFTRNE_FIT_INLINE std::vector<Eigen::VectorXd> capture_frame_std_errors(
-                const ArmFitResult& out, const std::vector<ParamSlot>& slots, const ArmDescription& start,
-                const io::Dataset& data, const std::vector<Eigen::Index>& rows, const ArmFitOptions& opt, double scale,
-                double marker_weight, const std::vector<int>& group, const Eigen::VectorXd& r0, std::atomic<int>& sims)
+    const ArmFitResult& out, const std::vector<ParamSlot>& slots, const ArmDescription& start,
+    const io::Dataset& data, const std::vector<Eigen::Index>& rows, const ArmFitOptions& opt,
+    double scale, double marker_weight, const std::vector<int>& group, const Eigen::VectorXd& r0,
+    std::atomic<int>& sims)
 #if SOFTRNE_FIT_BODIES
 {
   const int np = out.fit.params.size() == out.parameters.size() ? out.parameters.size() : 0;
@@ -465,8 +472,11 @@ SOFTRNE_FIT_INLINE std::vector<Eigen::VectorXd> capture_frame_std_errors(
 /// \param[in] frames The frames to measure in (one shared), or null to fit them.
 /// \param[out] fitted The frames used, if not null.
 /// \return The statistics; empty if the simulation failed or the data have no markers.
-SOFTRNE_FIT_INLINE signals::ErrorStats marker_errors(const ArmDescription& d, const io::Dataset& data, const sim::ArmSimulation& s,
-                                                     bool per_recording, const std::vector<CaptureFrame>* frames,
+SOFTRNE_FIT_INLINE signals::ErrorStats marker_errors(const ArmDescription& d,
+                                                     const io::Dataset& data,
+                                                     const sim::ArmSimulation& s,
+                                                     bool per_recording,
+                                                     const std::vector<CaptureFrame>* frames,
                                                      std::vector<CaptureFrame>* fitted = nullptr)
 #if SOFTRNE_FIT_BODIES
 {
