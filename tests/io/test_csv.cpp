@@ -13,6 +13,7 @@
 
 #include "softrne/io/csv.hpp"
 #include "softrne/io/robot_json.hpp"
+#include "temp_files.hpp"
 
 namespace sio = softrne::io;
 
@@ -20,18 +21,8 @@ namespace {
 
 const char* const kArmDir = SOFTRNE_DATA_DIR "/arm-a-1";
 
-std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("softrne_io_" + std::to_string(::getpid()) + "_" + name))
-      .string();
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using softrne_test::slurp;
+using softrne_test::temp_path;
 
 /// cc joint "joint1" (4 chambers), rigid link, revolute joint "wrist".
 const sio::RobotSpec& small_robot() {
@@ -56,7 +47,7 @@ const std::string kGood = "# a comment\n" + kHeader + kRow0 + kRow1 + kRow2;
 
 enum class Reader { Dataset, DatasetNeedAngles, Table };
 
-struct BadCase {
+struct BadCsvCase {
   std::string name;
   std::string text;
   Reader reader;
@@ -70,7 +61,7 @@ std::string replace_once(std::string s, const std::string& from, const std::stri
   return s.replace(p, from.size(), to);
 }
 
-std::vector<BadCase> bad_csv_cases() {
+std::vector<BadCsvCase> bad_csv_cases() {
   using C = sio::Category;
   using R = Reader;
   const std::string long_line =

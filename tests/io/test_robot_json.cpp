@@ -1,4 +1,3 @@
-// robot_json.hpp must compile on its own: it is included first.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "softrne/io/robot_json.hpp"
+#include "temp_files.hpp"
 
 namespace sio = softrne::io;
 using nlohmann::json;
@@ -20,18 +20,8 @@ namespace {
 
 const char* const kArmA = SOFTRNE_DATA_DIR "/arm-a-1/robot.json";
 
-std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("softrne_io_" + std::to_string(::getpid()) + "_" + name))
-      .string();
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using softrne_test::slurp;
+using softrne_test::temp_path;
 
 /// Exact (bitwise for doubles) equality of two robot descriptions.
 void expect_same(const sio::RobotSpec& a, const sio::RobotSpec& b) {
@@ -107,14 +97,14 @@ json& seg(json& j, int i) {
   return j["segments"][static_cast<std::size_t>(i)];
 }
 
-struct BadCase {
+struct BadRobotCase {
   std::string name;
   std::string text;
   sio::Category category;
   std::vector<std::string> expect;  // substrings of the message (besides the source name)
 };
 
-std::vector<BadCase> bad_robot_cases() {
+std::vector<BadRobotCase> bad_robot_cases() {
   using C = sio::Category;
   const std::string base = base_robot().dump(2);
   std::string dup_key = base;
