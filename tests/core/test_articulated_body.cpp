@@ -19,7 +19,7 @@
 #include "autodiff_reference.hpp"
 #include "support.hpp"
 
-namespace {
+namespace core_test_articulated_body {
 
 using namespace softrne;
 using softrne_test::rel_err;
@@ -454,6 +454,4 @@ TEST(ArticulatedBodyAllocation, NoHeapAllocation) {
   EXPECT_TRUE(ds.qddot.allFinite() && dd.qddot.allFinite());
 }
 
-SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
-
-}  // namespace
+}  // namespace core_test_articulated_body

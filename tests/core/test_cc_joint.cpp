@@ -12,7 +12,7 @@
 #include "softrne/segments/constant_curvature_joint.hpp"
 #include "support.hpp"
 
-namespace {
+namespace core_test_cc_joint {
 
 using softrne::ConstantCurvatureJoint;
 using Joint = ConstantCurvatureJoint<double>;
@@ -204,6 +204,4 @@ TEST(ConstantCurvatureJoint, PressureMapIsEquation24) {
   EXPECT_NEAR(tau(1), dA * (p(2) - p(3)), 1e-12);
 }
 
-SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
-
-}  // namespace
+}  // namespace core_test_cc_joint

@@ -13,7 +13,7 @@
 #include "softrne/algorithms/articulated_body.hpp"
 #include "softrne/algorithms/cholesky.hpp"
 
-namespace {
+namespace core_test_cholesky {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -104,4 +104,4 @@ TEST(Cholesky, InvertSpdSmallIsTheInverseForBlocksOfOneToFive) {
   check_invert_spd_small<5>(rng);
 }
 
-}  // namespace
+}  // namespace core_test_cholesky

@@ -24,7 +24,7 @@
 #include "autodiff_reference.hpp"
 #include "support.hpp"
 
-namespace {
+namespace core_test_derivatives {
 
 using namespace softrne;
 using Eigen::MatrixXd;
@@ -336,6 +336,4 @@ TEST(Derivatives, NoHeapAllocation) {
   EXPECT_GT(ds.dtau_dq.cwiseAbs().maxCoeff(), 0.0);
 }
 
-SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
-
-}  // namespace
+}  // namespace core_test_derivatives

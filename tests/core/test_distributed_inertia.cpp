@@ -16,7 +16,7 @@
 #include "autodiff_reference.hpp"
 #include "support.hpp"
 
-namespace {
+namespace core_test_distributed_inertia {
 
 using namespace softrne;
 using Eigen::Matrix3d;
@@ -501,6 +501,4 @@ TEST(DistributedAllocation, RuntimeChainAlgorithmsDoNotAllocateAfterMakeData) {
       << "heap allocation where forbidden";
 }
 
-SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
-
-}  // namespace
+}  // namespace core_test_distributed_inertia

@@ -18,7 +18,7 @@
 
 #include "softrne/softrne.hpp"
 
-namespace {
+namespace core_test_edge_cases {
 
 using Eigen::Matrix3d;
 using Eigen::MatrixXd;
@@ -390,4 +390,4 @@ TEST(EdgeCasesMisuse, DataOfSameSizedChainWithOtherSegmentsThrows) {
                   "this Data was made for another chain (segment 0 has another type");
 }
 
-}  // namespace
+}  // namespace core_test_edge_cases

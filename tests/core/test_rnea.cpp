@@ -13,7 +13,7 @@
 #include "autodiff_reference.hpp"
 #include "support.hpp"
 
-namespace {
+namespace core_test_rnea {
 
 using namespace softrne;
 using Eigen::MatrixXd;
@@ -256,6 +256,4 @@ TEST(RneaAllocation, RuntimeChainAlgorithmsDoNotAllocateAfterMakeData) {
       << "heap allocation where forbidden";
 }
 
-SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
-
-}  // namespace
+}  // namespace core_test_rnea

@@ -4,7 +4,7 @@
 #include "softrne/fit/arm_fit.hpp"
 #include "synthetic_arm.hpp"
 
-namespace {
+namespace fit_test_arm_fit {
 
 using namespace softrne;
 
@@ -96,4 +96,4 @@ TEST(ArmFit, BadDataIsRefusedWithAClearMessage) {
   }
 }
 
-}  // namespace
+}  // namespace fit_test_arm_fit

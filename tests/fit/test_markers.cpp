@@ -16,7 +16,7 @@
 #include "../sanitizer_build.hpp"
 #include "synthetic_arm.hpp"
 
-namespace {
+namespace fit_test_markers {
 
 using namespace softrne;
 
@@ -207,9 +207,9 @@ TEST(Markers, AFitFromMarkersAloneRecoversThePhysicsAndTheCaptureFrame) {
               data_sets, rms, worst, count, r.simulations, r.wall_seconds, r.marker_stats.total.mean);
 }
 
-}  // namespace
+}  // namespace fit_test_markers
 
-namespace {
+namespace fit_test_markers {
 
 TEST(Markers, EachRecordingInItsOwnCaptureFrame) {
   // Two logs whose motion-capture frames differ by a half turn (as the ETH trunk's logs do):
@@ -253,4 +253,4 @@ TEST(Markers, EachRecordingInItsOwnCaptureFrame) {
               "with one shared\n", r.marker_stats.total.mean, shared.marker_stats.total.mean);
 }
 
-}  // namespace
+}  // namespace fit_test_markers

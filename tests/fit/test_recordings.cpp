@@ -12,7 +12,7 @@
 #include "softrne/signals/initial_rate.hpp"
 #include "synthetic_arm.hpp"
 
-namespace {
+namespace fit_test_recordings {
 
 using namespace softrne;
 
@@ -187,4 +187,4 @@ TEST(Recordings, AFitOnLogsThatStartInMotionRecoversStiffnessAndDamping) {
               r.simulations, r.wall_seconds, r.stats.total.mean);
 }
 
-}  // namespace
+}  // namespace fit_test_recordings

@@ -19,7 +19,7 @@
 namespace sio = softrne::io;
 using nlohmann::json;
 
-namespace {
+namespace io_test_robot_json_inertia_model {
 
 const char* const kArmA = SOFTRNE_DATA_DIR "/arm-a-1/robot.json";
 
@@ -150,4 +150,4 @@ TEST(RobotJsonInertiaModel, ArmA1LumpedVsDistributedMassMatrix) {
   }
 }
 
-}  // namespace
+}  // namespace io_test_robot_json_inertia_model

@@ -337,6 +337,4 @@ TYPED_TEST(SegmentConformance, CalcDoesNotAllocate) {
   EXPECT_EQ(softrne_test::eigen_assert_failures, eigen_failures_before) << "heap allocation where forbidden";
 }
 
-SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
-
 }  // namespace

@@ -7,7 +7,7 @@
 
 #include "softrne/signals/input_signal.hpp"
 
-namespace {
+namespace signals_test_input_signal {
 
 using softrne::signals::InputSignal;
 using softrne::signals::Interpolation;
@@ -276,4 +276,4 @@ TEST(InputSignal, PchipIsExactOnLinesC1AndMonotone) {
   EXPECT_LT(worst_kink, 1e-5);
 }
 
-}  // namespace
+}  // namespace signals_test_input_signal

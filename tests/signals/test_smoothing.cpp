@@ -4,7 +4,7 @@
 
 #include "softrne/signals/smoothing.hpp"
 
-namespace {
+namespace signals_test_smoothing {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -27,4 +27,4 @@ TEST(Smoothing, IsOptionalZeroPhaseAndMonotone) {
   EXPECT_EQ(S(0, 1), 0.0);
 }
 
-}  // namespace
+}  // namespace signals_test_smoothing

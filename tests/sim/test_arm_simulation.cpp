@@ -29,7 +29,7 @@
 #define SOFTRNE_TEST_HAS_JSON 1
 #endif
 
-namespace {
+namespace sim_test_arm_simulation {
 
 using softrne::test::link;
 using softrne::test::three_joint_arm;
@@ -475,4 +475,4 @@ TEST(ArmSimulation, ReportsProgressAndFailsWithOneLine) {
   EXPECT_EQ(f.angles.rows(), f.states.rows());
 }
 
-}  // namespace
+}  // namespace sim_test_arm_simulation

@@ -17,7 +17,7 @@
 #include "softrne/sim/closed_loop.hpp"
 #include "test_arms.hpp"
 
-namespace {
+namespace sim_test_closed_loop {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -194,4 +194,4 @@ TEST(ClosedLoop, BadControllersAndArgumentsGiveOneLineErrors) {
   expect_error(simulate_closed_loop(d, zero, VectorXd(), 0.2, 0.01, bad), "initial_pressures has 3");
 }
 
-}  // namespace
+}  // namespace sim_test_closed_loop

@@ -19,7 +19,7 @@
 #include "oscillator.hpp"
 #include "softrne/signals/input_signal.hpp"
 
-namespace {
+namespace sim_test_cvode {
 
 using Eigen::Ref;
 using Eigen::VectorXd;
@@ -436,6 +436,4 @@ TEST(Cvode, SingleOutputTimeAndBreakpointsOutsideRange) {
     EXPECT_NEAR(r.x(i, 0), std::exp(-(times[i] - 1.0)), 1e-8);
 }
 
-SOFTRNE_MALLOC_GUARD_POSITIVE_CONTROL()
-
-}  // namespace
+}  // namespace sim_test_cvode

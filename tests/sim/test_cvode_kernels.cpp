@@ -22,7 +22,7 @@
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>
 
-namespace {
+namespace sim_test_cvode_kernels {
 
 using softrne::sim::detail::make_eigen_dense_solver;
 using softrne::sim::detail::use_softrne_vector_ops;
@@ -196,4 +196,4 @@ TEST(EigenDenseSolver, SingularAndNonFiniteMatricesAreRecoverableFailures) {
   SUNMatDestroy(A);
 }
 
-}  // namespace
+}  // namespace sim_test_cvode_kernels

@@ -12,7 +12,7 @@
 
 #include "oscillator.hpp"
 
-namespace {
+namespace sim_test_fixed_step {
 
 using softrne::sim::rk4_step;
 using softrne::sim::Rk4Workspace;
@@ -162,4 +162,4 @@ TEST(SemiImplicitEuler, FixedSizeMatchesHandComputation) {
   EXPECT_LT((q - q_new).norm(), 1e-15);
 }
 
-}  // namespace
+}  // namespace sim_test_fixed_step

@@ -22,7 +22,7 @@
 #include "softrne/sim/linearisation.hpp"
 #include "test_arms.hpp"
 
-namespace {
+namespace sim_test_linearisation {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -223,4 +223,4 @@ TEST(Linearisation, BadArgumentsGiveAClearError) {
   EXPECT_THROW(softrne::sim::discretise_zoh(lin, std::nan("")), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace sim_test_linearisation
