@@ -207,10 +207,6 @@ TEST(Markers, AFitFromMarkersAloneRecoversThePhysicsAndTheCaptureFrame) {
               data_sets, rms, worst, count, r.simulations, r.wall_seconds, r.marker_stats.total.mean);
 }
 
-}  // namespace fit_test_markers
-
-namespace fit_test_markers {
-
 TEST(Markers, EachRecordingInItsOwnCaptureFrame) {
   // Two logs whose motion-capture frames differ by a half turn (as the ETH trunk's logs do):
   // one frame per recording recovers both and the physics; one shared frame cannot fit them.
