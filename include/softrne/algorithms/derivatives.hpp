@@ -4,26 +4,27 @@
 /// inverse dynamics (rnea) and \f$\partial\ddot q/\partial(q,\dot q,\tau)\f$ of the forward
 /// dynamics (eq. 23), as Pinocchio's computeRNEADerivatives and computeABADerivatives.
 ///
-/// ## Method: the RNE's tangent, AutoDiff only on the perturbed segment
-/// The directions come in blocks of two, (q_i, qdot_i) for each coordinate i, and a block
-/// changes the RNE in three ways that are handled apart:
-/// - **the coordinate's own segment s** changes its kinematics (pose, Jacobians, their rates,
-///   its configuration-dependent inertia and every series below the CC functions' switches):
-///   its `calc`, `forward_step` and `backward_step` run in forward-mode AutoDiff
+/// ## Method: AutoDiff on the perturbed segment, world composites for the rest
+/// The directions come in blocks of two, (q_i, qdot_i) for each coordinate i of a segment s,
+/// and a block changes the RNE in three ways that are handled apart:
+/// - **segment s itself** changes its kinematics (pose, Jacobians, their rates, its
+///   configuration-dependent inertia and every series below the CC functions' switches): its
+///   `calc`, `forward_step` and `backward_step` run in forward-mode AutoDiff
 ///   (DerivativeScalar, two directions), the very code rnea() runs, on that segment alone;
-/// - **the segments after s** keep their kinematics but their base moves: the motion's
-///   derivatives are carried tip-wards and their loads' derivatives formed by the tangent
-///   steps of derivative_steps.hpp, in double, a 3 x 2 block per vector;
-/// - **every segment**: the wrench's derivatives come back base-wards, through s in AutoDiff
-///   and through the segments before s as a pure transmission (their loads do not move).
-/// So nq blocks cost nq AutoDiff evaluations of one segment plus O(n) double tangent steps
-/// each, against nq AutoDiff passes of the whole RNE before (28-35x rnea on the paper's arm;
-/// now 18x, docs/performance.md has both). Still exact to rounding (no step size), at phi = 0 and
-/// across the series switches, for every segment type (a new one is differentiated as soon as
-/// it has calc: the tangent steps read only the fields every segment's kinematics have).
-/// Analytical recursions for the CC joint itself (Pinocchio's computeRNEADerivatives has them
-/// for rigid joints) would also remove the AutoDiff on segment s: they need the second
-/// derivatives of a CC joint's pose, Jacobians and inertia (\f$\partial J/\partial q\f$,
+/// - **the coordinates after s** see their base's motion change: with the sensitivity rows of
+///   derivative_composites.hpp (one O(n) pass for all blocks, in world quantities as
+///   Pinocchio's computeRNEADerivatives) each such row costs one 12-vector product;
+/// - **the coordinates before s** see only the wrench s passes back: one 6-vector product each
+///   with their world Jacobian; and s's own rows take the children's wrench from the
+///   subtree's composite inertias (derivative_composites.hpp) into its AutoDiff backward step.
+/// So nq blocks cost nq AutoDiff evaluations of one segment plus O(nq) short products each.
+/// Until 2026-12-07 the rest of the chain was walked segment by segment in local axes for
+/// every block (3 x 2 tangent steps, O(n) each, 2.2-8x Pinocchio); docs/performance.md has
+/// both. Exact to rounding (no step size), at phi = 0 and across the series switches, for
+/// every segment type: a new one is differentiated as soon as it has calc (the composites read
+/// only the fields every segment's kinematics have). Analytical recursions for the CC joint
+/// itself would also remove the AutoDiff on segment s: they need the second derivatives of a
+/// CC joint's pose, Jacobians and inertia (\f$\partial J/\partial q\f$,
 /// \f$\partial\dot J\dot q/\partial q\f$, \f$\partial^2 I/\partial q^2\f$, per quadrature disk
 /// for a distributed joint) and their series below the switch, derived and tested anew.
 ///
@@ -41,7 +42,7 @@
 #include <Eigen/Core>
 
 #include "softrne/algorithms/cholesky.hpp"
-#include "softrne/algorithms/derivative_steps.hpp"
+#include "softrne/algorithms/derivative_composites.hpp"
 #include "softrne/algorithms/forward_dynamics.hpp"
 #include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/algorithms/rnea.hpp"
@@ -85,7 +86,10 @@ void prepare_derivatives(const DynamicChain<Scalar>& chain,
     ws.q.resize(nq);
     ws.qdot.resize(nq);
     ws.qddot.resize(nq);
-    ws.load_tangents.resize(static_cast<std::size_t>(chain.num_segments()));
+    ws.frames.resize(static_cast<std::size_t>(chain.num_segments() + 1));
+    ws.subtrees.resize(static_cast<std::size_t>(chain.num_segments() + 1));
+    ws.jacobian_t.resize(nq, 6);
+    ws.sensitivity.resize(nq, 9);
   }
   ws.chain.gravity = chain.gravity.template cast<AD>();
   ws.chain.inertia_rate = chain.inertia_rate;
@@ -123,10 +127,53 @@ Eigen::Matrix<AD, 3, 1> with_derivatives(const Eigen::Vector3d& value, const Tan
   return v;
 }
 
+/// \brief The columns (q_i, qdot_i) of \f$\partial\tau\f$ for the coordinate i of a fixed-axis
+/// joint s (is_fixed_axis_joint), in closed form from the composites (as Pinocchio's
+/// computeRNEADerivatives for its revolute joints). With S its world Jacobian, V_b and A_b its
+/// base's twist and spatial acceleration (derivative_composites.hpp's notation):
+/// - q_i turns everything from s on rigidly by S about a base that does not move:
+///   \f$\Delta V = V_b\times S\f$, \f$\Delta A = A_b\times S\f$ at the base, so the rows from s on
+///   change by \f$P\tilde a + R\Delta V\f$, and the rows before s by \f$J^T\delta F\f$ with the
+///   whole change of the wrench s passes back, \f$\delta F = S\times^* F_s + Y_{crb}\tilde a +
+///   D_{crb}\Delta V\f$;
+/// - qdot_i adds S to the twist beyond it and \f$V_b\times S\f$ to its spatial acceleration
+///   (\f$\dot S = V\times S\f$): \f$\Delta V = S\f$, \f$\tilde a = 2 V_b\times S\f$, the same rows
+///   (s's own included: it has no body, so its row is its children's wrench through S).
+template <class Data>
+void fixed_axis_derivatives(Data& data, int s, int i) {
+  const auto& ws = data.derivatives;
+  const auto k = static_cast<std::size_t>(s);
+  const FrameInWorld& base = ws.frames[k];
+  const Vector6d S = ws.jacobian_t.row(i).transpose();
+  const Vector6d& V = base.twist;
+  Eigen::Matrix<double, 6, kDerivativeBlock> dV;
+  dV.col(0) = cross_motion(V, S);
+  dV.col(1) = S;
+  Eigen::Matrix<double, 9, kDerivativeBlock> x;  // (a~; dV's angular part)
+  x.template topRows<6>().col(0) = cross_motion(base.acceleration, S) + cross_motion(V, dV.col(0));
+  x.template topRows<6>().col(1) = 2.0 * dV.col(0);
+  x.template bottomRows<3>() = dV.template bottomRows<3>();
+  const int nq = static_cast<int>(data.dtau_dq.rows());
+  const auto rows = ws.sensitivity.bottomRows(nq - i);
+  data.dtau_dq.col(i).tail(nq - i).noalias() = rows * x.col(0);
+  data.dtau_dqdot.col(i).tail(nq - i).noalias() = rows * x.col(1);
+  if (i > 0) {
+    const SubtreeComposite& from_s = ws.subtrees[k];
+    Eigen::Matrix<double, 6, kDerivativeBlock> dF =
+        from_s.apply(x.template topRows<6>(), x.template bottomRows<3>());
+    Vector6d F;
+    F << data.wrench[k].force, data.wrench[k].torque;
+    dF.col(0) += cross_force(S, force_to_world(base.R, base.p, F));
+    const auto before = ws.jacobian_t.topRows(i);
+    data.dtau_dq.col(i).head(i).noalias() = before * dF.col(0);
+    data.dtau_dqdot.col(i).head(i).noalias() = before * dF.col(1);
+  }
+}
+
 /// \brief \f$\partial\tau/\partial q\f$ and \f$\partial\tau/\partial\dot q\f$ of the RNE at
 /// (q, qdot, qddot) into data.dtau_dq and data.dtau_dqdot (the file comment: one block
-/// (q_i, qdot_i) per coordinate, AutoDiff on the coordinate's own segment, the tangent steps
-/// elsewhere); tau itself into data.tau, and the RNE's kinematics, motions, loads and wrenches
+/// (q_i, qdot_i) per coordinate, AutoDiff on the coordinate's own segment, the composites of
+/// derivative_composites.hpp elsewhere); tau itself into data.tau, and the RNE's kinematics, motions, loads and wrenches
 /// at that point into data.
 template <class ChainT, class Q, class Qd, class Qdd>
 void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
@@ -149,81 +196,101 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
     ws.qddot(i) = AD(qddot(i));
   }
 
+  compute_derivative_composites(chain, data, qdot);
+  const auto& frames = ws.frames;
+
   for (int s = 0; s < n_seg; ++s) {
     int s_offset = 0, s_nq = 0;
+    bool fixed_axis = false;
     chain.visit_segment(data, s, [&](const auto& seg, const auto&, int, int offset) {
+      using Segment = std::decay_t<decltype(seg)>;
       s_offset = offset;
-      s_nq = std::decay_t<decltype(seg)>::nq;
+      s_nq = Segment::nq;
+      fixed_axis = is_fixed_axis_joint<Segment>::value;
     });
+    const auto k = static_cast<std::size_t>(s);
+    if (fixed_axis) {
+      fixed_axis_derivatives(data, s, s_offset);
+      continue;
+    }
+    const int s_end = s_offset + s_nq;
+    const FrameInWorld& base = frames[k];
+    const FrameInWorld& distal = frames[k + 1];
+    const Eigen::Vector3d& w_d = data.motion[k + 1].omega;  // distal axes
+    const Eigen::Vector3d v_d = distal.R.transpose() * distal.v;
+    const Eigen::Vector3d v_b = base.R.transpose() * base.v;
     for (int j = 0; j < s_nq; ++j) {
       const int i = s_offset + j;  // the block: directions (q_i, qdot_i)
       ws.q(i).derivatives() << 1, 0;
       ws.qdot(i).derivatives() << 0, 1;
 
       // Segment s in AutoDiff: its kinematics and its forward step (its base does not move).
-      MotionTangent d_motion;
+      // The distal frame's twist and spatial acceleration in its own axes, derived: (dv; dw)
+      // and (da - dw x v - w x dv; dalpha) (a spatial acceleration is a - w x v at the origin).
+      Eigen::Matrix<double, 6, kDerivativeBlock> dV, dA;
       ws.chain.visit_segment(ws.data, s, [&](const auto& seg, auto& kin, int, int offset) {
         constexpr int n = std::decay_t<decltype(seg)>::nq;
         seg.calc(segment_entries<n>(ws.q, offset), segment_entries<n>(ws.qdot, offset), kin);
-        const auto k = static_cast<std::size_t>(s);
         forward_step(seg, kin, autodiff_constant<AD>(data.motion[k]),
                      segment_entries<n>(ws.qdot, offset), segment_entries<n>(ws.qddot, offset),
                      true, rate, ws.data.motion[k + 1], ws.data.loads[k]);
-        d_motion.omega = derivatives_of(ws.data.motion[k + 1].omega);
-        d_motion.alpha = derivatives_of(ws.data.motion[k + 1].alpha);
-        d_motion.acc = derivatives_of(ws.data.motion[k + 1].acc);
+        Eigen::Matrix<AD, 3, 1> v = v_b.template cast<AD>();
+        v += data.motion[k].omega.template cast<AD>().cross(kin.r_base_distal);
+        if constexpr (n > 0)
+          v += kin.J_distal.template topRows<3>() * segment_entries<n>(ws.qdot, offset);
+        const Tangent3 dv = derivatives_of(Eigen::Matrix<AD, 3, 1>(kin.R_base_distal.transpose() * v));
+        const Tangent3 dw = derivatives_of(ws.data.motion[k + 1].omega);
+        dV.template topRows<3>() = dv;
+        dV.template bottomRows<3>() = dw;
+        dA.template topRows<3>() = derivatives_of(ws.data.motion[k + 1].acc);
+        dA.template topRows<3>().noalias() += skew(v_d) * dw;
+        dA.template topRows<3>().noalias() -= skew(w_d) * dv;
+        dA.template bottomRows<3>() = derivatives_of(ws.data.motion[k + 1].alpha);
       });
-      // The segments after it: their base moves, their kinematics do not.
-      chain.forward(data, [&](const auto& seg, const auto& kin, int k, int offset) {
-        if (k <= s) return;
+      // In the world, and a~ = dA + V x dV (derivative_composites.hpp).
+      const Eigen::Matrix<double, 6, kDerivativeBlock> delta_V =
+          motion_to_world(distal.R, distal.p, dV);
+      Eigen::Matrix<double, 9, kDerivativeBlock> x;  // (a~; dV's angular part)
+      x.template topRows<6>() = motion_to_world(distal.R, distal.p, dA);
+      for (int c = 0; c < kDerivativeBlock; ++c)
+        x.template topRows<6>().col(c) += cross_motion(distal.twist, delta_V.col(c));
+      x.template bottomRows<3>() = delta_V.template bottomRows<3>();
+      // The coordinates after s: their sensitivity rows.
+      if (s_end < nq) {
+        const auto rows = ws.sensitivity.bottomRows(nq - s_end);
+        data.dtau_dq.col(i).tail(nq - s_end).noalias() = rows * x.col(0);
+        data.dtau_dqdot.col(i).tail(nq - s_end).noalias() = rows * x.col(1);
+      }
+      // The wrench of everything after s, in s's distal axes about its origin.
+      const SubtreeComposite& beyond = ws.subtrees[k + 1];
+      const Eigen::Matrix<double, 6, kDerivativeBlock> d_children =
+          beyond.apply(x.template topRows<6>(), x.template bottomRows<3>());
+      const Eigen::Matrix<double, 6, kDerivativeBlock> d_local = force_to_local(distal.R, distal.p, d_children);
+      // Segment s itself in AutoDiff, backward.
+      Eigen::Matrix<double, 6, kDerivativeBlock> d_base;
+      ws.chain.visit_segment(ws.data, s, [&](const auto& seg, const auto& kin, int, int) {
         constexpr int n = std::decay_t<decltype(seg)>::nq;
-        MotionTangent d_distal;
-        forward_tangent_step(seg, kin, data.motion[static_cast<std::size_t>(k)],
-                             segment_entries<n>(qdot, offset), rate, d_motion, d_distal,
-                             ws.load_tangents[static_cast<std::size_t>(k)]);
-        d_motion = d_distal;
-      });
-      // Backward: the segments after s (loads and wrench move), s itself in AutoDiff, then the
-      // segments before it (only the wrench from their children moves).
-      WrenchTangent d_wrench;  // zero at the tip
-      auto store = [&](const auto& d_tau, int offset) {
-        for (Eigen::Index r = 0; r < d_tau.rows(); ++r) {
-          data.dtau_dq(offset + r, i) = d_tau(r, 0);
-          data.dtau_dqdot(offset + r, i) = d_tau(r, 1);
-        }
-      };
-      auto transmit = [&](bool own_load_moves) {
-        return [&, own_load_moves](const auto& seg, const auto& kin, int k, int offset) {
-          if (own_load_moves ? k <= s : k >= s) return;
-          using Segment = std::decay_t<decltype(seg)>;
-          const auto kk = static_cast<std::size_t>(k);
-          Eigen::Matrix<double, Segment::nq, kDerivativeBlock> d_tau;
-          WrenchTangent d_base;
-          backward_tangent_step<Segment>(kin, data.loads[kk],
-                                         own_load_moves ? &ws.load_tangents[kk] : nullptr,
-                                         d_wrench, rate, d_tau, d_base);
-          store(d_tau, offset);
-          d_wrench = d_base;
-        };
-      };
-      chain.backward(data, transmit(true));
-      ws.chain.visit_segment(ws.data, s, [&](const auto& seg, const auto& kin, int, int offset) {
-        constexpr int n = std::decay_t<decltype(seg)>::nq;
-        const auto k = static_cast<std::size_t>(s);
-        Wrench<AD> distal, base;
-        distal.force = with_derivatives<AD>(data.wrench[k + 1].force, d_wrench.force);
-        distal.torque = with_derivatives<AD>(data.wrench[k + 1].torque, d_wrench.torque);
+        Wrench<AD> children, base_wrench;
+        children.force = with_derivatives<AD>(data.wrench[k + 1].force, d_local.template topRows<3>());
+        children.torque = with_derivatives<AD>(data.wrench[k + 1].torque, d_local.template bottomRows<3>());
         Eigen::Matrix<AD, n, 1> tau;
-        backward_step(seg, kin, ws.data.loads[k], distal, rate, tau, base);
+        backward_step(seg, kin, ws.data.loads[k], children, rate, tau, base_wrench);
         if constexpr (n > 0) {  // (s has coordinates; the others are never visited here)
-          Eigen::Matrix<double, n, kDerivativeBlock> d_tau;
-          for (int r = 0; r < n; ++r) d_tau.row(r) = tau(r).derivatives().transpose();
-          store(d_tau, offset);
+          for (int r = 0; r < n; ++r) {
+            data.dtau_dq(s_offset + r, i) = tau(r).derivatives()(0);
+            data.dtau_dqdot(s_offset + r, i) = tau(r).derivatives()(1);
+          }
         }
-        d_wrench.force = derivatives_of(base.force);
-        d_wrench.torque = derivatives_of(base.torque);
+        d_base.template topRows<3>() = derivatives_of(base_wrench.force);
+        d_base.template bottomRows<3>() = derivatives_of(base_wrench.torque);
       });
-      chain.backward(data, transmit(false));
+      // The coordinates before s: the wrench their segments transmit.
+      if (s_offset > 0) {
+        const Eigen::Matrix<double, 6, kDerivativeBlock> d_world = force_to_world(base.R, base.p, d_base);
+        const auto rows = ws.jacobian_t.topRows(s_offset);
+        data.dtau_dq.col(i).head(s_offset).noalias() = rows * d_world.col(0);
+        data.dtau_dqdot.col(i).head(s_offset).noalias() = rows * d_world.col(1);
+      }
 
       ws.q(i).derivatives().setZero();
       ws.qdot(i).derivatives().setZero();
@@ -236,9 +303,10 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
 /// \brief Derivatives of the inverse dynamics \f$\tau = M(q)\ddot q + C(q,\dot q)\dot q +
 /// G(q)\f$ (rnea()): \f$\partial\tau/\partial q\f$, \f$\partial\tau/\partial\dot q\f$ and
 /// \f$\partial\tau/\partial\ddot q = M(q)\f$, each in its own field of data (as Pinocchio's
-/// computeRNEADerivatives). Exact (this file's comment: the RNE's tangent, AutoDiff on the
-/// perturbed segment only); cost one rnea(), nq one-segment AutoDiff evaluations with O(n)
-/// tangent steps each, and mass_matrix(). Allocates nothing for a
+/// computeRNEADerivatives). Exact (this file's comment: AutoDiff on the perturbed segment
+/// only, world composites for the rest); cost one rnea(), one O(n) composite pass, nq
+/// one-segment AutoDiff evaluations with O(nq) short products each, and mass_matrix().
+/// Allocates nothing for a
 /// compile-time chain; a DynamicChain's Data sizes its derivative workspace at the first call.
 ///
 /// \tparam ChainT A Chain<...> or a DynamicChain<Scalar> of a floating-point Scalar.

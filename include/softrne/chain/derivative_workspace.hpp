@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// \brief Workspace of the derivatives of the dynamics (algorithms/derivatives.hpp): the chain
-/// in a forward-mode AutoDiff scalar and that chain's own workspace, kept in the chains' Data
-/// so that rnea_derivatives and aba_derivatives allocate nothing for a compile-time chain.
+/// in a forward-mode AutoDiff scalar and that chain's own workspace, and the world composites
+/// of the expansion point (algorithms/derivative_composites.hpp), kept in the chains' Data so
+/// that rnea_derivatives and aba_derivatives allocate nothing for a compile-time chain.
 
 #include <array>
 #include <type_traits>
@@ -33,34 +34,67 @@ namespace detail {
 /// \brief A block of derivatives of a 3-vector: column k along direction k of the block.
 using Tangent3 = Eigen::Matrix<double, 3, kDerivativeBlock>;
 
-/// \brief The derivatives of a frame's motion (FrameMotion) along one block.
-struct MotionTangent {
-  Tangent3 omega = Tangent3::Zero(), alpha = Tangent3::Zero(), acc = Tangent3::Zero();
+/// \brief A frame at the expansion point, in the world (the chain's base frame): its pose, the
+/// velocity of its origin, and its twist about the world origin (linear; angular).
+struct FrameInWorld {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  ///< orientation
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();      ///< origin
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();      ///< velocity of the origin
+  Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();  ///< (v_O; omega)
+  /// Its spatial acceleration about the world origin, \f$(a - \alpha\times p - \omega\times v;
+  /// \alpha)\f$ (gravity in it, as in the RNE's accelerations).
+  Eigen::Matrix<double, 6, 1> acceleration = Eigen::Matrix<double, 6, 1>::Zero();
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
-/// \brief The derivatives of a wrench (Wrench) along one block.
-struct WrenchTangent {
-  Tangent3 force = Tangent3::Zero(), torque = Tangent3::Zero();
+/// \brief What the bodies from one frame to the tip offer a perturbation of that frame, in the
+/// world about the world origin (algorithms/derivative_composites.hpp): their composite spatial
+/// inertia \f$Y = \begin{pmatrix} m & -[h]_\times\\ [h]_\times & I_O\end{pmatrix}\f$ and
+/// the composite of their velocity terms \f$D = \begin{pmatrix} 0 & -2[p]_\times\\ 0 &
+/// X\end{pmatrix}\f$, kept as their blocks.
+struct SubtreeComposite {
+  double mass = 0;                                        ///< m
+  Eigen::Vector3d first_moment = Eigen::Vector3d::Zero();  ///< h = sum of m c
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();       ///< I_O, about the world origin
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();      ///< p = sum of m v_c
+  Eigen::Matrix3d velocity = Eigen::Matrix3d::Zero();      ///< X
+
+  /// \brief Y a + D (0; dw), columnwise: the wrench's change for (a~; dV's angular part).
+  template <class A, class W>
+  Eigen::Matrix<double, 6, A::ColsAtCompileTime> apply(const Eigen::MatrixBase<A>& a,
+                                                       const Eigen::MatrixBase<W>& dw) const {
+    Eigen::Matrix<double, 6, A::ColsAtCompileTime> out(6, a.cols());
+    for (Eigen::Index j = 0; j < a.cols(); ++j) {
+      const Eigen::Vector3d lin = a.col(j).template head<3>(), ang = a.col(j).template tail<3>();
+      const Eigen::Vector3d w = dw.col(j);
+      out.col(j).template head<3>() = mass * lin - first_moment.cross(ang) - 2.0 * momentum.cross(w);
+      out.col(j).template tail<3>() = first_moment.cross(lin);
+      out.col(j).template tail<3>().noalias() += inertia * ang;
+      out.col(j).template tail<3>().noalias() += velocity * w;
+    }
+    return out;
+  }
+
+  /// \brief This += other.
+  void add(const SubtreeComposite& other) {
+    mass += other.mass;
+    first_moment += other.first_moment;
+    inertia += other.inertia;
+    momentum += other.momentum;
+    velocity += other.velocity;
+  }
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
-/// \brief The derivatives of a segment's body load (BodyLoad) along one block.
-struct LoadTangent {
-  Tangent3 force = Tangent3::Zero(), torque = Tangent3::Zero();
-  Tangent3 omega_distal = Tangent3::Zero(), tau_sub_bodies = Tangent3::Zero();
-  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+/// \brief One T per frame (num_segments + 1): a std::vector for a runtime chain (sized by the
+/// first call), a std::array for a compile-time one (no heap).
+template <class ChainT, class T>
+struct PerFrame {
+  using type = std::vector<T, Eigen::aligned_allocator<T>>;
 };
-
-/// \brief One LoadTangent per segment: a std::vector for a runtime chain (sized by the first
-/// call), a std::array for a compile-time one (no heap).
-template <class ChainT>
-struct LoadTangents {
-  using type = std::vector<LoadTangent>;
-};
-template <class... Segments>
-struct LoadTangents<Chain<Segments...>> {
-  using type = std::array<LoadTangent, sizeof...(Segments)>;
+template <class... Segments, class T>
+struct PerFrame<Chain<Segments...>, T> {
+  using type = std::array<T, sizeof...(Segments) + 1>;
 };
 
 }  // namespace detail
@@ -71,7 +105,8 @@ template <class ChainT, bool = std::is_floating_point_v<typename ChainT::Scalar>
 struct DerivativeWorkspace {};
 
 /// \brief The chain in DerivativeScalar, its workspace, the AutoDiff arguments of one
-/// segment's evaluation and the per-segment load derivatives (algorithms/derivatives.hpp).
+/// segment's evaluation (algorithms/derivatives.hpp) and the world composites of the
+/// expansion point (algorithms/derivative_composites.hpp).
 /// derivatives.hpp copies the chain's constants into `chain` at every call (the chain may have
 /// changed since), so the workspace never holds stale parameters.
 template <class ChainT>
@@ -84,8 +119,17 @@ struct DerivativeWorkspace<ChainT, true> {
   typename ChainAD::VectorQ q;             ///< q of one pass, seeded
   typename ChainAD::VectorQ qdot;          ///< qdot of one pass, seeded
   typename ChainAD::VectorQ qddot;         ///< qddot (no derivatives)
-  /// Per segment: its body load's derivatives along the block being propagated.
-  typename detail::LoadTangents<ChainT>::type load_tangents;
+  static constexpr int kNq = ChainT::VectorQ::RowsAtCompileTime;  ///< nq or Dynamic
+  /// Per frame (frame k: segment k's base; the last: the tip): its pose and velocity...
+  typename detail::PerFrame<ChainT, detail::FrameInWorld>::type frames;
+  /// ... and the composite of the segments from it to the tip.
+  typename detail::PerFrame<ChainT, detail::SubtreeComposite>::type subtrees;
+  /// Per coordinate (row), the world Jacobian of its segment's distal frame, transposed: a
+  /// wrench at the world origin -> its generalised forces.
+  Eigen::Matrix<double, kNq, 6> jacobian_t;
+  /// Per coordinate (row), the sensitivities (P | R) of its generalised force to a perturbation
+  /// of its segment's base: d tau = P a~ + R dV_angular (derivative_composites.hpp).
+  Eigen::Matrix<double, kNq, 9> sensitivity;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 

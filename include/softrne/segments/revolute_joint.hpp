@@ -22,6 +22,11 @@ struct RevoluteJoint {
   /// r_base_distal = 0 by construction: placements skip the shift (spatial/frame_placement.hpp;
   /// the conformance suite checks it).
   static constexpr bool zero_translation = true;
+  /// The distal frame turns by q about the constant axis J_distal (its angular rows) through
+  /// the base origin, a rigid rotation of everything beyond it: the derivatives differentiate
+  /// it in closed form, without AutoDiff (algorithms/derivatives.hpp; it takes the axis as unit,
+  /// as the robot file must give it).
+  static constexpr bool fixed_axis = true;
   using Kinematics = SegmentKinematics<Scalar, nq>;  ///< what calc() fills
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;       ///< a 3-vector
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;       ///< a 3x3 matrix

@@ -1,0 +1,237 @@
+#pragma once
+/// \file
+/// \brief What the rest of the chain does with a perturbation of one frame's motion, in world
+/// quantities (Pinocchio's computeRNEADerivatives works the same way for rigid joints): the
+/// linear maps that let derivatives.hpp carry the perturbation of one segment's coordinates to
+/// every other row of \f$\partial\tau\f$ in O(1) per row.
+///
+/// ## Derivation
+/// Spatial vectors about the world origin, (linear; angular) (spatial/spatial_algebra.hpp).
+/// Every body m of the model (a segment's lumped body, or one sub-body of a distributed CC
+/// joint) has a twist \f$v_m = V_b + J_m\dot q\f$ (V_b: its segment's base frame; J_m the
+/// world Jacobian of its centre and its angular velocity), a spatial inertia \f$Y_m\f$, and
+/// the d'Alembert wrench of the RNE (eqs. 16-18) \f$f_m = Y_m a_m + v_m\times^* Y_m v_m +
+/// \dot I_m\omega_m\f$ (the last: InertiaRate::Consistent, a lumped CC body), a_m its
+/// spatial acceleration. A coordinate's force is \f$\tau_k = \sum_m J_{k,m}^T f_m\f$
+/// (\f$-\tfrac12\omega^T\partial_k I\,\omega\f$ for its own lumped CC body) over the bodies
+/// it moves. All of this is covariant: moving everything rigidly moves \f$f_m\f$ with it and
+/// leaves \f$\tau\f$ alone.
+///
+/// Perturb one frame F (a segment's distal frame) by a twist \f$\xi\f$ of its pose and
+/// \f$\delta V, \delta A\f$ of its twist and spatial acceleration, the coordinates beyond it
+/// fixed. Only the non-rigid parts \f$\Delta V = \delta V - \xi\times V\f$ and \f$\Delta A =
+/// \delta A - \xi\times A\f$ (the derivatives of F's motion in its own axes, carried to the
+/// world) change anything, and for every body m beyond F (V_F, v_m at the expansion point):
+/// \f$\Delta v_m = \Delta V\f$ and \f$\Delta a_m = \Delta A + \Delta V\times(v_m - V_F)\f$.
+/// With \f$D_m = \partial f_m/\partial v_m - Y_m[v_m\times] = [\,\cdot\times^* Y_m v_m] +
+/// [v_m\times^*]Y_m - Y_m[v_m\times] + \dot I_m\f$:
+/// - the wrench of everything beyond F changes by \f$\xi\times^* F + Y_{crb}\tilde a +
+///   D_{crb}\Delta V\f$, with \f$\tilde a = \Delta A + V_F\times\Delta V\f$ and the composites
+///   \f$Y_{crb} = \sum Y_m\f$, \f$D_{crb} = \sum D_m\f$ over those bodies (the frame's
+///   SubtreeComposite);
+/// - a coordinate k beyond F changes by \f$P_k\tilde a + R_k\Delta V\f$, with
+///   \f$P_k = \sum_m J_{k,m}^T Y_m\f$ and \f$R_k = \sum_m J_{k,m}^T D_m + E_k\f$ (E_k: the
+///   \f$-\omega^T\partial_k I\f$ of its own lumped CC body) over the bodies it moves; neither
+///   depends on F, so one pass fills them for all perturbations (the sensitivity rows).
+/// A coordinate before F sees only the wrench its segment transmits: \f$\delta\tau_k =
+/// J_k^T\delta F\f$ (J_k: its distal frame's world Jacobian).
+///
+/// The tests (tests/core/test_derivatives.cpp) hold the result to central finite differences
+/// and to an AutoDiff pass of the whole RNE.
+
+#include <type_traits>
+
+#include <Eigen/Core>
+
+#include "softrne/algorithms/kinematics.hpp"
+#include "softrne/algorithms/rnea_steps.hpp"
+#include "softrne/chain/derivative_workspace.hpp"
+#include "softrne/spatial/inertia_transforms.hpp"
+#include "softrne/spatial/spatial_algebra.hpp"
+
+namespace softrne {
+namespace detail {
+
+/// \brief true for a segment that declares `static constexpr bool fixed_axis = true` (a
+/// RevoluteJoint): one coordinate, no body, no translation, and a rigid rotation about the
+/// constant axis of J_distal. Its coordinate moves everything beyond its base rigidly by the
+/// twist S = its world Jacobian, so its derivatives need no AutoDiff (derivatives.hpp).
+template <class Segment, class = void>
+struct is_fixed_axis_joint : std::false_type {};
+template <class Segment>
+struct is_fixed_axis_joint<Segment, std::void_t<decltype(Segment::fixed_axis)>>
+    : std::bool_constant<Segment::fixed_axis && Segment::nq == 1 && !Segment::has_body &&
+                         has_zero_translation<Segment>::value> {};
+
+/// \brief A segment's distal frame in the world from its base frame (at the expansion point),
+/// and the world Jacobian of the distal frame's twist, transposed (nq x 6, rows of its
+/// coordinates).
+/// \param[in] motion_distal The distal frame's motion in its own axes (the RNE's).
+template <class Segment, class Qd, class JacobianT>
+void world_frame_step(const typename Segment::Kinematics& kin, const FrameInWorld& base,
+                      const FrameMotion<double>& motion_distal, const Eigen::MatrixBase<Qd>& qdot,
+                      FrameInWorld& distal, JacobianT&& jacobian_t) {
+  constexpr int nq = Segment::nq;
+  distal.R.noalias() = base.R * kin.R_base_distal;
+  distal.p = base.p;
+  distal.p.noalias() += base.R * kin.r_base_distal;
+  const Eigen::Vector3d w = distal.R * motion_distal.omega;
+  distal.v = base.v + base.twist.template tail<3>().cross(distal.p - base.p);
+  if constexpr (nq > 0) {
+    const Eigen::Vector3d v_rel = kin.J_distal.template topRows<3>() * qdot;
+    distal.v.noalias() += base.R * v_rel;
+    Eigen::Matrix<double, 6, nq> J;
+    J.template bottomRows<3>().noalias() = base.R * kin.J_distal.template bottomRows<3>();
+    J.template topRows<3>().noalias() = base.R * kin.J_distal.template topRows<3>();
+    J.template topRows<3>().noalias() += skew(distal.p) * J.template bottomRows<3>();
+    jacobian_t = J.transpose();
+  } else {
+    (void)qdot;
+    (void)jacobian_t;
+  }
+  distal.twist.template head<3>() = distal.v + distal.p.cross(w);
+  distal.twist.template tail<3>() = w;
+  const Eigen::Vector3d alpha = distal.R * motion_distal.alpha;
+  distal.acceleration.template head<3>() = distal.R * motion_distal.acc;
+  distal.acceleration.template head<3>() += distal.p.cross(alpha) - w.cross(distal.v);
+  distal.acceleration.template tail<3>() = alpha;
+}
+
+/// \brief The sensitivity rows (P | R, nq x 9) that the bodies of `c` give coordinates moving
+/// them all with the world Jacobian J (6 x nq): \f$(J^T Y \mid J^T D)\f$, D's zero linear
+/// columns dropped.
+template <int NQ>
+Eigen::Matrix<double, NQ, 9> sensitivity_rows(const SubtreeComposite& c,
+                                              const Eigen::Matrix<double, 6, NQ>& J) {
+  Eigen::Matrix<double, NQ, 9> rows;
+  for (int j = 0; j < NQ; ++j) {
+    const Eigen::Vector3d lin = J.col(j).template head<3>(), ang = J.col(j).template tail<3>();
+    // (Y J_j)^T (Y is symmetric), then (D^T J_j)^T = (2 p x lin + X^T ang)^T.
+    rows.row(j).template head<3>() = (c.mass * lin - c.first_moment.cross(ang)).transpose();
+    rows.row(j).template segment<3>(3) =
+        (c.first_moment.cross(lin) + c.inertia * ang).transpose();
+    rows.row(j).template tail<3>() =
+        (2.0 * c.momentum.cross(lin) + c.velocity.transpose() * ang).transpose();
+  }
+  return rows;
+}
+
+/// \brief A segment's own bodies (the file comment): their composite (Y, D) into `own` and
+/// their share of the segment's sensitivity rows (P | R, nq x 9) into `rows`, both from zero.
+/// \param[in] load The body load of the RNE at the expansion point (its omega_distal).
+template <class Segment, class Qd, class Rows>
+void own_body_composite(const Segment& seg, const typename Segment::Kinematics& kin,
+                        const BodyLoad<double>& load, const FrameInWorld& base,
+                        const FrameInWorld& distal, const Eigen::MatrixBase<Qd>& qdot,
+                        InertiaRate inertia_rate, SubtreeComposite& own, Rows&& rows) {
+  using Matrix3 = Eigen::Matrix3d;
+  using Vector3 = Eigen::Vector3d;
+  constexpr int nq = Segment::nq;
+  own = SubtreeComposite{};
+  if constexpr (nq > 0) rows.setZero();
+  // One rigid body: mass m, centre c_base (base axes), inertia I_c about it (world axes),
+  // Jacobians of its centre and angular velocity (base axes), and the rate of its inertia
+  // (world axes) if it has one.
+  auto add_body = [&](double m, const Vector3& c_base, const Matrix3& I_c, const auto& Jv,
+                      const auto& Jw, const Matrix3* rate) {
+    SubtreeComposite b;
+    const Vector3 c = base.p + base.R * c_base;
+    b.mass = m;
+    b.first_moment = m * c;
+    b.inertia = I_c;
+    add_shift(b.inertia, c, Vector3(0.5 * b.first_moment));  // I_O = I_c - m [c]^2
+    Vector6d v = base.twist;
+    Eigen::Matrix<double, 6, nq> J;
+    if constexpr (nq > 0) {
+      J.template bottomRows<3>().noalias() = base.R * Jw;
+      J.template topRows<3>().noalias() = base.R * Jv;
+      J.template topRows<3>().noalias() += skew(c) * J.template bottomRows<3>();
+      v.noalias() += J * qdot;
+    } else {
+      (void)Jv;
+      (void)Jw;
+    }
+    // D (file comment) in closed form: with the momentum p = m v_c and the angular momentum
+    // L = I_O w + h x v_O, D = (0, -2[p]; 0, X), X = -[L] + [w] I_O - I_O [w] - [v_O][h] -
+    // [h][v_O] (+ I-dot): its linear columns vanish. [a][b] + [b][a] = a b^T + b a^T - 2 a.b 1.
+    const Vector3 w = v.tail<3>(), v_O = v.head<3>();
+    b.momentum = m * v_O + w.cross(b.first_moment);
+    const Vector3 L = b.inertia * w + b.first_moment.cross(v_O);
+    const Matrix3 WI = skew(w) * b.inertia;
+    b.velocity = WI + WI.transpose() - skew(L);
+    b.velocity.noalias() -= v_O * b.first_moment.transpose() + b.first_moment * v_O.transpose();
+    b.velocity.diagonal().array() += 2.0 * v_O.dot(b.first_moment);
+    if (rate) b.velocity += *rate;
+    if constexpr (nq > 0) rows += sensitivity_rows<nq>(b, J);
+    own.add(b);
+  };
+  if constexpr (num_sub_bodies<Segment> > 0) {
+    (void)seg;
+    (void)load;
+    (void)distal;
+    (void)inertia_rate;
+    for (const auto& b : kin.sub_bodies)
+      add_body(b.mass, b.r_base_body, rotate_symmetric(base.R, b.inertia), b.J_v, b.J_w,
+               nullptr);
+  } else if constexpr (Segment::has_body) {
+    const bool rate = nq > 0 && inertia_rate == InertiaRate::Consistent;
+    Matrix3 rate_world;
+    if (rate) rate_world = rotate_symmetric(distal.R, kin.inertia_rate);
+    add_body(seg.mass, kin.r_base_com, rotate_symmetric(distal.R, kin.inertia_com), kin.J_com,
+             kin.J_distal.template bottomRows<3>(), rate ? &rate_world : nullptr);
+    // E_k: d/dV of -1/2 w^T dI/dq_k w (backward_step), through the angular part.
+    if constexpr (nq > 0)
+      if (rate)
+        for (int k = 0; k < nq; ++k)
+          rows.row(k).template tail<3>() -=
+              (distal.R * (kin.dinertia_dq[static_cast<std::size_t>(k)] * load.omega_distal))
+                  .transpose();
+  } else {
+    (void)seg;
+    (void)kin;
+    (void)load;
+    (void)distal;
+    (void)inertia_rate;
+  }
+}
+
+/// \brief At the expansion point the RNE left in data (kinematics, motions, loads): every
+/// frame in the world (ws.frames), every frame's SubtreeComposite (ws.subtrees), and every
+/// coordinate's Jacobian and sensitivity rows (ws.jacobian_t, ws.sensitivity). O(n).
+template <class ChainT, class Qd>
+void compute_derivative_composites(const ChainT& chain, typename ChainT::Data& data,
+                                   const Eigen::MatrixBase<Qd>& qdot) {
+  auto& ws = data.derivatives;
+  const InertiaRate rate = chain.inertia_rate;
+  ws.frames[0] = FrameInWorld{};  // the world: at rest, its acceleration -g (rnea_passes)
+  ws.frames[0].acceleration.template head<3>() = data.motion[0].acc;
+  chain.forward(data, [&](const auto& seg, const auto& kin, int k, int offset) {
+    using Segment = std::decay_t<decltype(seg)>;
+    constexpr int n = Segment::nq;
+    const auto kk = static_cast<std::size_t>(k);
+    world_frame_step<Segment>(kin, ws.frames[kk], data.motion[kk + 1],
+                              segment_entries<n>(qdot, offset), ws.frames[kk + 1],
+                              ws.jacobian_t.template middleRows<n>(offset));
+  });
+  const auto n_seg = static_cast<std::size_t>(data.num_segments());
+  ws.subtrees[n_seg] = SubtreeComposite{};
+  chain.backward(data, [&](const auto& seg, const auto& kin, int k, int offset) {
+    using Segment = std::decay_t<decltype(seg)>;
+    constexpr int n = Segment::nq;
+    const auto kk = static_cast<std::size_t>(k);
+    SubtreeComposite own;
+    auto rows = ws.sensitivity.template middleRows<n>(offset);
+    own_body_composite(seg, kin, data.loads[kk], ws.frames[kk], ws.frames[kk + 1],
+                       segment_entries<n>(qdot, offset), rate, own, rows);
+    const SubtreeComposite& beyond = ws.subtrees[kk + 1];
+    if constexpr (n > 0) {
+      const Eigen::Matrix<double, 6, n> J = ws.jacobian_t.template middleRows<n>(offset).transpose();
+      rows += sensitivity_rows<n>(beyond, J);
+    }
+    ws.subtrees[kk] = beyond;
+    ws.subtrees[kk].add(own);
+  });
+}
+
+}  // namespace detail
+}  // namespace softrne
