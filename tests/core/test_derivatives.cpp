@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "softrne/algorithms/derivatives.hpp"
+#include "softrne/algorithms/mass_matrix.hpp"
 #include "autodiff_reference.hpp"
 #include "support.hpp"
 
@@ -128,7 +129,7 @@ struct Worst {
 };
 
 /// rnea_derivatives at (q, qd, qdd) against FD (kFdTolRnea) and, if built, one dynamic-size
-/// AutoDiff pass of rnea (1e-9); d tau/d qddot against M by FD in qddot.
+/// AutoDiff pass of rnea (1e-9); d tau/d qddot against FD in qddot and mass_matrix() (1e-12).
 void check_rnea(const DynamicChain<double>& chain, const VectorXd& q, const VectorXd& qd,
                 const VectorXd& qdd, Worst& w) {
   auto data = chain.make_data();
@@ -137,6 +138,8 @@ void check_rnea(const DynamicChain<double>& chain, const VectorXd& q, const Vect
   const VectorXd tau = data.tau;
   auto fd_data = chain.make_data();
   EXPECT_LT(rel_err(tau, rnea(chain, fd_data, q, qd, qdd)), 1e-14);
+  // d tau/d qddot comes from the derivatives' own composites: the same M as the CRBA's.
+  EXPECT_LT(rel_err(M, mass_matrix(chain, fd_data, q)), 1e-12);
   const MatrixXd fq = finite_difference(q, kFdStep, [&](const VectorXd& x) { return rnea(chain, fd_data, x, qd, qdd); });
   const MatrixXd fqd = finite_difference(qd, kFdStep, [&](const VectorXd& x) { return rnea(chain, fd_data, q, x, qdd); });
   const MatrixXd fqdd = finite_difference(qdd, kFdStep, [&](const VectorXd& x) { return rnea(chain, fd_data, q, qd, x); });

@@ -64,71 +64,87 @@ struct is_fixed_axis_joint<Segment, std::void_t<decltype(Segment::fixed_axis)>>
                          has_zero_translation<Segment>::value> {};
 
 /// \brief A segment's distal frame in the world from its base frame (at the expansion point),
-/// and the world Jacobian of the distal frame's twist, transposed (nq x 6, rows of its
-/// coordinates).
+/// and the world Jacobian of the distal frame's twist (6 x nq, columns of its coordinates).
 /// \param[in] motion_distal The distal frame's motion in its own axes (the RNE's).
 template <class Segment, class Qd, class JacobianT>
 void world_frame_step(const typename Segment::Kinematics& kin, const FrameInWorld& base,
                       const FrameMotion<double>& motion_distal, const Eigen::MatrixBase<Qd>& qdot,
-                      FrameInWorld& distal, JacobianT&& jacobian_t) {
+                      FrameInWorld& distal, JacobianT&& jacobian) {
   constexpr int nq = Segment::nq;
-  distal.R.noalias() = base.R * kin.R_base_distal;
+  if constexpr (has_identity_rotation<Segment>::value)
+    distal.R = base.R;
+  else
+    distal.R.noalias() = base.R * kin.R_base_distal;
   distal.p = base.p;
-  distal.p.noalias() += base.R * kin.r_base_distal;
+  if constexpr (!has_zero_translation<Segment>::value)
+    distal.p.noalias() += base.R * kin.r_base_distal;
   const Eigen::Vector3d w = distal.R * motion_distal.omega;
-  distal.v = base.v + base.twist.template tail<3>().cross(distal.p - base.p);
+  distal.v = base.v;
+  if constexpr (!has_zero_translation<Segment>::value) {
+    distal.v += cross3(base.twist.template tail<3>(), distal.p - base.p);
+    if constexpr (nq > 0) {
+      const Eigen::Vector3d v_rel = kin.J_distal.template topRows<3>() * qdot;
+      distal.v.noalias() += base.R * v_rel;
+    }
+  }
   if constexpr (nq > 0) {
-    const Eigen::Vector3d v_rel = kin.J_distal.template topRows<3>() * qdot;
-    distal.v.noalias() += base.R * v_rel;
-    Eigen::Matrix<double, 6, nq> J;
-    J.template bottomRows<3>().noalias() = base.R * kin.J_distal.template bottomRows<3>();
-    J.template topRows<3>().noalias() = base.R * kin.J_distal.template topRows<3>();
-    J.template topRows<3>().noalias() += skew(distal.p) * J.template bottomRows<3>();
-    jacobian_t = J.transpose();
+    // (R J_v + p x R J_w; R J_w): the twist about the world origin.
+    jacobian.template bottomRows<3>().noalias() = base.R * kin.J_distal.template bottomRows<3>();
+    if constexpr (has_zero_translation<Segment>::value)
+      jacobian.template topRows<3>().setZero();
+    else
+      jacobian.template topRows<3>().noalias() = base.R * kin.J_distal.template topRows<3>();
+    for (int j = 0; j < nq; ++j)
+      jacobian.col(j).template head<3>() += cross3(distal.p, jacobian.col(j).template tail<3>());
   } else {
     (void)qdot;
-    (void)jacobian_t;
+    (void)jacobian;
   }
-  distal.twist.template head<3>() = distal.v + distal.p.cross(w);
+  distal.twist.template head<3>() = distal.v + cross3(distal.p, w);
   distal.twist.template tail<3>() = w;
   const Eigen::Vector3d alpha = distal.R * motion_distal.alpha;
   distal.acceleration.template head<3>() = distal.R * motion_distal.acc;
-  distal.acceleration.template head<3>() += distal.p.cross(alpha) - w.cross(distal.v);
+  distal.acceleration.template head<3>() += cross3(distal.p, alpha) - cross3(w, distal.v);
   distal.acceleration.template tail<3>() = alpha;
 }
 
-/// \brief The sensitivity rows (P | R, nq x 9) that the bodies of `c` give coordinates moving
-/// them all with the world Jacobian J (6 x nq): \f$(J^T Y \mid J^T D)\f$, D's zero linear
-/// columns dropped.
-template <int NQ>
-Eigen::Matrix<double, NQ, 9> sensitivity_rows(const SubtreeComposite& c,
-                                              const Eigen::Matrix<double, 6, NQ>& J) {
-  Eigen::Matrix<double, NQ, 9> rows;
+/// \brief The sensitivities (P | R)^T (9 x nq) that the bodies of `c` give coordinates moving
+/// them all with the world Jacobian J (6 x nq): \f$(Y J;\ D^T J)\f$, D's zero linear columns
+/// dropped.
+template <int NQ, class JacobianT>
+Eigen::Matrix<double, 9, NQ> sensitivity_of(const SubtreeComposite& c, const JacobianT& J) {
+  Eigen::Matrix<double, 9, NQ> out;
   for (int j = 0; j < NQ; ++j) {
     const Eigen::Vector3d lin = J.col(j).template head<3>(), ang = J.col(j).template tail<3>();
-    // (Y J_j)^T (Y is symmetric), then (D^T J_j)^T = (2 p x lin + X^T ang)^T.
-    rows.row(j).template head<3>() = (c.mass * lin - c.first_moment.cross(ang)).transpose();
-    rows.row(j).template segment<3>(3) =
-        (c.first_moment.cross(lin) + c.inertia * ang).transpose();
-    rows.row(j).template tail<3>() =
-        (2.0 * c.momentum.cross(lin) + c.velocity.transpose() * ang).transpose();
+    // Y J_j (Y is symmetric), then D^T J_j = 2 p x lin + X^T ang.
+    out.col(j).template head<3>() = c.mass * lin - cross3(c.first_moment, ang);
+    out.col(j).template segment<3>(3) = cross3(c.first_moment, lin);
+    out.col(j).template segment<3>(3).noalias() += c.inertia * ang;
+    out.col(j).template tail<3>() = 2.0 * cross3(c.momentum, lin);
+    out.col(j).template tail<3>().noalias() += c.velocity.transpose() * ang;
   }
-  return rows;
+  return out;
 }
 
-/// \brief A segment's own bodies (the file comment): their composite (Y, D) into `own` and
-/// their share of the segment's sensitivity rows (P | R, nq x 9) into `rows`, both from zero.
+/// \brief A segment's own bodies (the file comment): their composite (Y, D) into `own`, their
+/// share of the segment's sensitivities ((P | R)^T, 9 x nq) into `cols` and of its block of
+/// the mass matrix (\f$\sum_m J_m^T Y_m J_m\f$) into `joint`, all from zero.
 /// \param[in] load The body load of the RNE at the expansion point (its omega_distal).
-template <class Segment, class Qd, class Rows>
+template <class Segment, class Qd>
 void own_body_composite(const Segment& seg, const typename Segment::Kinematics& kin,
                         const BodyLoad<double>& load, const FrameInWorld& base,
                         const FrameInWorld& distal, const Eigen::MatrixBase<Qd>& qdot,
-                        InertiaRate inertia_rate, SubtreeComposite& own, Rows&& rows) {
+                        InertiaRate inertia_rate, SubtreeComposite& own,
+                        Eigen::Matrix<double, 9, Segment::nq>& cols,
+                        Eigen::Matrix<double, Segment::nq, Segment::nq>& joint) {
   using Matrix3 = Eigen::Matrix3d;
   using Vector3 = Eigen::Vector3d;
   constexpr int nq = Segment::nq;
   own = SubtreeComposite{};
-  if constexpr (nq > 0) rows.setZero();
+  if constexpr (nq > 0) {
+    cols.setZero();
+    joint.setZero();
+  }
   // One rigid body: mass m, centre c_base (base axes), inertia I_c about it (world axes),
   // Jacobians of its centre and angular velocity (base axes), and the rate of its inertia
   // (world axes) if it has one.
@@ -145,7 +161,8 @@ void own_body_composite(const Segment& seg, const typename Segment::Kinematics& 
     if constexpr (nq > 0) {
       J.template bottomRows<3>().noalias() = base.R * Jw;
       J.template topRows<3>().noalias() = base.R * Jv;
-      J.template topRows<3>().noalias() += skew(c) * J.template bottomRows<3>();
+      for (int j = 0; j < nq; ++j)
+        J.col(j).template head<3>() += cross3(c, J.col(j).template tail<3>());
       v.noalias() += J * qdot;
     } else {
       (void)Jv;
@@ -155,14 +172,18 @@ void own_body_composite(const Segment& seg, const typename Segment::Kinematics& 
     // L = I_O w + h x v_O, D = (0, -2[p]; 0, X), X = -[L] + [w] I_O - I_O [w] - [v_O][h] -
     // [h][v_O] (+ I-dot): its linear columns vanish. [a][b] + [b][a] = a b^T + b a^T - 2 a.b 1.
     const Vector3 w = v.tail<3>(), v_O = v.head<3>();
-    b.momentum = m * v_O + w.cross(b.first_moment);
-    const Vector3 L = b.inertia * w + b.first_moment.cross(v_O);
+    b.momentum = m * v_O + cross3(w, b.first_moment);
+    const Vector3 L = b.inertia * w + cross3(b.first_moment, v_O);
     const Matrix3 WI = skew(w) * b.inertia;
     b.velocity = WI + WI.transpose() - skew(L);
     b.velocity.noalias() -= v_O * b.first_moment.transpose() + b.first_moment * v_O.transpose();
     b.velocity.diagonal().array() += 2.0 * v_O.dot(b.first_moment);
     if (rate) b.velocity += *rate;
-    if constexpr (nq > 0) rows += sensitivity_rows<nq>(b, J);
+    if constexpr (nq > 0) {
+      const Eigen::Matrix<double, 9, nq> c_b = sensitivity_of<nq>(b, J);
+      cols += c_b;
+      joint.noalias() += c_b.template topRows<6>().transpose() * J;
+    }
     own.add(b);
   };
   if constexpr (num_sub_bodies<Segment> > 0) {
@@ -183,9 +204,8 @@ void own_body_composite(const Segment& seg, const typename Segment::Kinematics& 
     if constexpr (nq > 0)
       if (rate)
         for (int k = 0; k < nq; ++k)
-          rows.row(k).template tail<3>() -=
-              (distal.R * (kin.dinertia_dq[static_cast<std::size_t>(k)] * load.omega_distal))
-                  .transpose();
+          cols.col(k).template tail<3>() -=
+              distal.R * (kin.dinertia_dq[static_cast<std::size_t>(k)] * load.omega_distal);
   } else {
     (void)seg;
     (void)kin;
@@ -197,10 +217,16 @@ void own_body_composite(const Segment& seg, const typename Segment::Kinematics& 
 
 /// \brief At the expansion point the RNE left in data (kinematics, motions, loads): every
 /// frame in the world (ws.frames), every frame's SubtreeComposite (ws.subtrees), and every
-/// coordinate's Jacobian and sensitivity rows (ws.jacobian_t, ws.sensitivity). O(n).
+/// coordinate's Jacobian and sensitivities (ws.jacobian, ws.sensitivity). O(n). With `mass`,
+/// also the mass matrix from the same composites (as Pinocchio's computeRNEADerivatives fills
+/// M): \f$M_{kj} = P_k J_j\f$ for j in an earlier segment than k (\f$\partial\tau_k/\partial\ddot
+/// q_j\f$: a unit \f$\ddot q_j\f$ is \f$\Delta A = J_j\f$), and a segment's own block
+/// \f$\sum_m J_m^T Y_m J_m + J^T Y_{crb} J\f$ (its own bodies, then everything beyond it).
+/// O(nq^2).
 template <class ChainT, class Qd>
 void compute_derivative_composites(const ChainT& chain, typename ChainT::Data& data,
-                                   const Eigen::MatrixBase<Qd>& qdot) {
+                                   const Eigen::MatrixBase<Qd>& qdot,
+                                   typename ChainT::MatrixQ* mass) {
   auto& ws = data.derivatives;
   const InertiaRate rate = chain.inertia_rate;
   ws.frames[0] = FrameInWorld{};  // the world: at rest, its acceleration -g (rnea_passes)
@@ -211,7 +237,7 @@ void compute_derivative_composites(const ChainT& chain, typename ChainT::Data& d
     const auto kk = static_cast<std::size_t>(k);
     world_frame_step<Segment>(kin, ws.frames[kk], data.motion[kk + 1],
                               segment_entries<n>(qdot, offset), ws.frames[kk + 1],
-                              ws.jacobian_t.template middleRows<n>(offset));
+                              ws.jacobian.template middleCols<n>(offset));
   });
   const auto n_seg = static_cast<std::size_t>(data.num_segments());
   ws.subtrees[n_seg] = SubtreeComposite{};
@@ -219,17 +245,31 @@ void compute_derivative_composites(const ChainT& chain, typename ChainT::Data& d
     using Segment = std::decay_t<decltype(seg)>;
     constexpr int n = Segment::nq;
     const auto kk = static_cast<std::size_t>(k);
-    SubtreeComposite own;
-    auto rows = ws.sensitivity.template middleRows<n>(offset);
-    own_body_composite(seg, kin, data.loads[kk], ws.frames[kk], ws.frames[kk + 1],
-                       segment_entries<n>(qdot, offset), rate, own, rows);
     const SubtreeComposite& beyond = ws.subtrees[kk + 1];
+    SubtreeComposite own;
+    Eigen::Matrix<double, 9, n> cols;
+    Eigen::Matrix<double, n, n> joint;
+    own_body_composite(seg, kin, data.loads[kk], ws.frames[kk], ws.frames[kk + 1],
+                       segment_entries<n>(qdot, offset), rate, own, cols, joint);
     if constexpr (n > 0) {
-      const Eigen::Matrix<double, 6, n> J = ws.jacobian_t.template middleRows<n>(offset).transpose();
-      rows += sensitivity_rows<n>(beyond, J);
+      const Eigen::Matrix<double, 6, n> J = ws.jacobian.template middleCols<n>(offset);
+      const Eigen::Matrix<double, 9, n> c_beyond = sensitivity_of<n>(beyond, J);
+      ws.sensitivity.template middleCols<n>(offset) = cols + c_beyond;
+      if (mass) {
+        joint.noalias() += c_beyond.template topRows<6>().transpose() * J;
+        mass->template block<n, n>(offset, offset) = joint;
+      }
     }
     ws.subtrees[kk] = beyond;
     ws.subtrees[kk].add(own);
+  });
+  if (!mass) return;
+  chain.forward(data, [&](const auto& seg, const auto&, int, int offset) {
+    constexpr int n = std::decay_t<decltype(seg)>::nq;
+    for (int r = offset; r < offset + n; ++r)
+      for (int j = 0; j < offset; ++j)
+        (*mass)(j, r) = (*mass)(r, j) =
+            ws.sensitivity.col(r).template head<6>().dot(ws.jacobian.col(j));
   });
 }
 

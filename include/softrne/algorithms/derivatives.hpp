@@ -37,6 +37,8 @@
 
 #include <limits>
 #include <type_traits>
+#include <tuple>
+#include <utility>
 #include <variant>
 
 #include <Eigen/Core>
@@ -44,7 +46,6 @@
 #include "softrne/algorithms/cholesky.hpp"
 #include "softrne/algorithms/derivative_composites.hpp"
 #include "softrne/algorithms/forward_dynamics.hpp"
-#include "softrne/algorithms/mass_matrix.hpp"
 #include "softrne/algorithms/rnea.hpp"
 #include "softrne/chain/derivative_workspace.hpp"
 #include "softrne/chain/dynamic_chain.hpp"
@@ -53,16 +54,14 @@
 namespace softrne {
 namespace detail {
 
-/// \brief The chain's constants into ws.chain (a compile-time chain: a copy on the stack).
+/// \brief Nothing to prepare for a compile-time chain: its workspace is fixed-size, and the
+/// AutoDiff copy of a segment is made when it is evaluated (segment_to_autodiff).
 template <class... Segments>
-void prepare_derivatives(const Chain<Segments...>& chain,
-                         typename Chain<Segments...>::Data& data) {
-  using AD = typename DerivativeWorkspace<Chain<Segments...>>::AD;
-  data.derivatives.chain = chain.template cast<AD>();
-}
+void prepare_derivatives(const Chain<Segments...>&, typename Chain<Segments...>::Data&) {}
 
-/// \brief The chain's constants into ws.chain, segment by segment; the first call (or a chain
-/// of another layout) builds the AD chain, its workspace and the outputs (allocates once).
+/// \brief The first call (or a chain of another layout) builds the AD chain, its workspace and
+/// the outputs (allocates once); later calls check the layout only. The constants of a
+/// segment are copied when it is evaluated (segment_to_autodiff).
 template <class Scalar>
 void prepare_derivatives(const DynamicChain<Scalar>& chain,
                          typename DynamicChain<Scalar>::Data& data) {
@@ -73,10 +72,7 @@ void prepare_derivatives(const DynamicChain<Scalar>& chain,
     std::visit(
         [&](const auto& seg) {
           using SegAD = decltype(seg.template cast<AD>());
-          if (auto* s = std::get_if<SegAD>(&ws.chain.segment(i)))
-            *s = seg.template cast<AD>();
-          else
-            same = false;
+          same = std::holds_alternative<SegAD>(ws.chain.segment(i));
         },
         chain.segment(i));
   const int nq = chain.num_coordinates();
@@ -88,14 +84,38 @@ void prepare_derivatives(const DynamicChain<Scalar>& chain,
     ws.qddot.resize(nq);
     ws.frames.resize(static_cast<std::size_t>(chain.num_segments() + 1));
     ws.subtrees.resize(static_cast<std::size_t>(chain.num_segments() + 1));
-    ws.jacobian_t.resize(nq, 6);
-    ws.sensitivity.resize(nq, 9);
+    ws.jacobian.resize(6, nq);
+    ws.sensitivity.resize(9, nq);
   }
-  ws.chain.gravity = chain.gravity.template cast<AD>();
-  ws.chain.inertia_rate = chain.inertia_rate;
   for (auto* m : {&data.dtau_dq, &data.dtau_dqdot, &data.dqddot_dq, &data.dqddot_dqdot,
                   &data.dqddot_dtau})
     m->resize(nq, nq);  // no-op after the first call
+}
+
+/// \brief Segment s's constants into the AD chain (the chain may have changed since the last
+/// call, so this runs before every AutoDiff evaluation of s).
+template <class ChainAD, class... Segments, std::size_t... I>
+void segment_to_autodiff(const Chain<Segments...>& chain, ChainAD& chain_ad, int s,
+                         std::index_sequence<I...>) {
+  using AD = typename ChainAD::Scalar;
+  ((static_cast<int>(I) == s
+        ? void(std::get<I>(chain_ad.segments) = std::get<I>(chain.segments).template cast<AD>())
+        : void()),
+   ...);
+}
+template <class ChainAD, class... Segments>
+void segment_to_autodiff(const Chain<Segments...>& chain, ChainAD& chain_ad, int s) {
+  segment_to_autodiff(chain, chain_ad, s, std::index_sequence_for<Segments...>{});
+}
+template <class ChainAD, class Scalar>
+void segment_to_autodiff(const DynamicChain<Scalar>& chain, ChainAD& chain_ad, int s) {
+  using AD = typename ChainAD::Scalar;
+  std::visit(
+      [&](const auto& seg) {
+        using SegAD = decltype(seg.template cast<AD>());
+        std::get<SegAD>(chain_ad.segment(s)) = seg.template cast<AD>();
+      },
+      chain.segment(s));
 }
 
 /// \brief The values of a FrameMotion as AutoDiff constants (no derivatives).
@@ -144,7 +164,7 @@ void fixed_axis_derivatives(Data& data, int s, int i) {
   const auto& ws = data.derivatives;
   const auto k = static_cast<std::size_t>(s);
   const FrameInWorld& base = ws.frames[k];
-  const Vector6d S = ws.jacobian_t.row(i).transpose();
+  const Vector6d S = ws.jacobian.col(i);
   const Vector6d& V = base.twist;
   Eigen::Matrix<double, 6, kDerivativeBlock> dV;
   dV.col(0) = cross_motion(V, S);
@@ -154,9 +174,10 @@ void fixed_axis_derivatives(Data& data, int s, int i) {
   x.template topRows<6>().col(1) = 2.0 * dV.col(0);
   x.template bottomRows<3>() = dV.template bottomRows<3>();
   const int nq = static_cast<int>(data.dtau_dq.rows());
-  const auto rows = ws.sensitivity.bottomRows(nq - i);
-  data.dtau_dq.col(i).tail(nq - i).noalias() = rows * x.col(0);
-  data.dtau_dqdot.col(i).tail(nq - i).noalias() = rows * x.col(1);
+  for (int r = i; r < nq; ++r) {
+    data.dtau_dq(r, i) = ws.sensitivity.col(r).dot(x.col(0));
+    data.dtau_dqdot(r, i) = ws.sensitivity.col(r).dot(x.col(1));
+  }
   if (i > 0) {
     const SubtreeComposite& from_s = ws.subtrees[k];
     Eigen::Matrix<double, 6, kDerivativeBlock> dF =
@@ -164,21 +185,23 @@ void fixed_axis_derivatives(Data& data, int s, int i) {
     Vector6d F;
     F << data.wrench[k].force, data.wrench[k].torque;
     dF.col(0) += cross_force(S, force_to_world(base.R, base.p, F));
-    const auto before = ws.jacobian_t.topRows(i);
-    data.dtau_dq.col(i).head(i).noalias() = before * dF.col(0);
-    data.dtau_dqdot.col(i).head(i).noalias() = before * dF.col(1);
+    for (int r = 0; r < i; ++r) {
+      data.dtau_dq(r, i) = ws.jacobian.col(r).dot(dF.col(0));
+      data.dtau_dqdot(r, i) = ws.jacobian.col(r).dot(dF.col(1));
+    }
   }
 }
 
 /// \brief \f$\partial\tau/\partial q\f$ and \f$\partial\tau/\partial\dot q\f$ of the RNE at
 /// (q, qdot, qddot) into data.dtau_dq and data.dtau_dqdot (the file comment: one block
 /// (q_i, qdot_i) per coordinate, AutoDiff on the coordinate's own segment, the composites of
-/// derivative_composites.hpp elsewhere); tau itself into data.tau, and the RNE's kinematics, motions, loads and wrenches
-/// at that point into data.
+/// derivative_composites.hpp elsewhere); tau itself into data.tau, the RNE's kinematics,
+/// motions, loads and wrenches at that point into data, and with `with_mass_matrix`
+/// \f$\partial\tau/\partial\ddot q = M\f$ from the same composites into data.mass_matrix.
 template <class ChainT, class Q, class Qd, class Qdd>
 void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
                             const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
-                            const Eigen::MatrixBase<Qdd>& qddot) {
+                            const Eigen::MatrixBase<Qdd>& qddot, bool with_mass_matrix) {
   static_assert(std::is_floating_point_v<typename ChainT::Scalar>,
                 "softrne: derivatives need a chain of a floating-point scalar");
   prepare_derivatives(chain, data);
@@ -196,7 +219,7 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
     ws.qddot(i) = AD(qddot(i));
   }
 
-  compute_derivative_composites(chain, data, qdot);
+  compute_derivative_composites(chain, data, qdot, with_mass_matrix ? &data.mass_matrix : nullptr);
   const auto& frames = ws.frames;
 
   for (int s = 0; s < n_seg; ++s) {
@@ -225,6 +248,7 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
       ws.qdot(i).derivatives() << 0, 1;
 
       // Segment s in AutoDiff: its kinematics and its forward step (its base does not move).
+      if (j == 0) segment_to_autodiff(chain, ws.chain, s);
       // The distal frame's twist and spatial acceleration in its own axes, derived: (dv; dw)
       // and (da - dw x v - w x dv; dalpha) (a spatial acceleration is a - w x v at the origin).
       Eigen::Matrix<double, 6, kDerivativeBlock> dV, dA;
@@ -256,10 +280,9 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
         x.template topRows<6>().col(c) += cross_motion(distal.twist, delta_V.col(c));
       x.template bottomRows<3>() = delta_V.template bottomRows<3>();
       // The coordinates after s: their sensitivity rows.
-      if (s_end < nq) {
-        const auto rows = ws.sensitivity.bottomRows(nq - s_end);
-        data.dtau_dq.col(i).tail(nq - s_end).noalias() = rows * x.col(0);
-        data.dtau_dqdot.col(i).tail(nq - s_end).noalias() = rows * x.col(1);
+      for (int r = s_end; r < nq; ++r) {
+        data.dtau_dq(r, i) = ws.sensitivity.col(r).dot(x.col(0));
+        data.dtau_dqdot(r, i) = ws.sensitivity.col(r).dot(x.col(1));
       }
       // The wrench of everything after s, in s's distal axes about its origin.
       const SubtreeComposite& beyond = ws.subtrees[k + 1];
@@ -287,9 +310,10 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
       // The coordinates before s: the wrench their segments transmit.
       if (s_offset > 0) {
         const Eigen::Matrix<double, 6, kDerivativeBlock> d_world = force_to_world(base.R, base.p, d_base);
-        const auto rows = ws.jacobian_t.topRows(s_offset);
-        data.dtau_dq.col(i).head(s_offset).noalias() = rows * d_world.col(0);
-        data.dtau_dqdot.col(i).head(s_offset).noalias() = rows * d_world.col(1);
+        for (int r = 0; r < s_offset; ++r) {
+          data.dtau_dq(r, i) = ws.jacobian.col(r).dot(d_world.col(0));
+          data.dtau_dqdot(r, i) = ws.jacobian.col(r).dot(d_world.col(1));
+        }
       }
 
       ws.q(i).derivatives().setZero();
@@ -304,10 +328,11 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
 /// G(q)\f$ (rnea()): \f$\partial\tau/\partial q\f$, \f$\partial\tau/\partial\dot q\f$ and
 /// \f$\partial\tau/\partial\ddot q = M(q)\f$, each in its own field of data (as Pinocchio's
 /// computeRNEADerivatives). Exact (this file's comment: AutoDiff on the perturbed segment
-/// only, world composites for the rest); cost one rnea(), one O(n) composite pass, nq
-/// one-segment AutoDiff evaluations with O(nq) short products each, and mass_matrix().
-/// Allocates nothing for a
-/// compile-time chain; a DynamicChain's Data sizes its derivative workspace at the first call.
+/// only, world composites for the rest); cost one rnea(), one O(n) composite pass that also
+/// gives M (mass_matrix() agrees with it to rounding; the tests hold both to finite
+/// differences), and nq one-segment AutoDiff evaluations (none for a fixed-axis joint) with
+/// O(nq) short products each. Allocates nothing for a compile-time chain; a DynamicChain's
+/// Data sizes its derivative workspace at the first call.
 ///
 /// \tparam ChainT A Chain<...> or a DynamicChain<Scalar> of a floating-point Scalar.
 /// \param[in] chain The model.
@@ -326,8 +351,7 @@ void rnea_derivatives(const ChainT& chain, typename ChainT::Data& data,
   detail::check_argument(chain, "rnea_derivatives", "qdot", qdot);
   detail::check_argument(chain, "rnea_derivatives", "qddot", qddot);
   chain.check_data(data);
-  detail::rnea_derivative_passes(chain, data, q, qdot, qddot);
-  mass_matrix(chain, data, q);
+  detail::rnea_derivative_passes(chain, data, q, qdot, qddot, true);
 }
 
 /// \brief Derivatives of the forward dynamics \f$\ddot q = M(q)^{-1}(\tau - C(q,\dot q)\dot q -
@@ -369,14 +393,14 @@ void aba_derivatives(const ChainT& chain, typename ChainT::Data& data,
     data.dqddot_dtau.setConstant(nan);
     return;
   }
-  detail::rnea_derivative_passes(chain, data, q, qdot, data.qddot);
-  // M^-1 from the factor forward_dynamics left (cholesky.hpp), then the two products.
-  const int nq = chain.num_coordinates();
+  detail::rnea_derivative_passes(chain, data, q, qdot, data.qddot, false);
+  // M^-1 = L^-T L^-1 from the factor forward_dynamics left (cholesky.hpp), by Eigen's blocked
+  // triangular solves (double only, so cholesky.hpp's reason to avoid them does not apply;
+  // column by column was 16 us of 44 on the 30-joint chain), then the two products.
   data.dqddot_dtau.setIdentity();
-  for (int c = 0; c < nq; ++c) {
-    auto column = data.dqddot_dtau.col(c);
-    detail::cholesky_solve_factored(data.mass_factor, column);
-  }
+  data.mass_factor.template triangularView<Eigen::Lower>().solveInPlace(data.dqddot_dtau);
+  data.mass_factor.transpose().template triangularView<Eigen::Upper>().solveInPlace(
+      data.dqddot_dtau);
   data.dqddot_dq.noalias() = -data.dqddot_dtau * data.dtau_dq;
   data.dqddot_dqdot.noalias() = -data.dqddot_dtau * data.dtau_dqdot;
 }

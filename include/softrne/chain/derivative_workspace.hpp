@@ -13,6 +13,8 @@
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
+#include "softrne/spatial/skew.hpp"
+
 namespace softrne {
 
 /// \brief Derivative directions carried by one AutoDiff evaluation of the derivatives: a
@@ -61,14 +63,14 @@ struct SubtreeComposite {
 
   /// \brief Y a + D (0; dw), columnwise: the wrench's change for (a~; dV's angular part).
   template <class A, class W>
-  Eigen::Matrix<double, 6, A::ColsAtCompileTime> apply(const Eigen::MatrixBase<A>& a,
+  EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, A::ColsAtCompileTime> apply(const Eigen::MatrixBase<A>& a,
                                                        const Eigen::MatrixBase<W>& dw) const {
     Eigen::Matrix<double, 6, A::ColsAtCompileTime> out(6, a.cols());
     for (Eigen::Index j = 0; j < a.cols(); ++j) {
       const Eigen::Vector3d lin = a.col(j).template head<3>(), ang = a.col(j).template tail<3>();
       const Eigen::Vector3d w = dw.col(j);
-      out.col(j).template head<3>() = mass * lin - first_moment.cross(ang) - 2.0 * momentum.cross(w);
-      out.col(j).template tail<3>() = first_moment.cross(lin);
+      out.col(j).template head<3>() = mass * lin - cross3(first_moment, ang) - 2.0 * cross3(momentum, w);
+      out.col(j).template tail<3>() = cross3(first_moment, lin);
       out.col(j).template tail<3>().noalias() += inertia * ang;
       out.col(j).template tail<3>().noalias() += velocity * w;
     }
@@ -124,12 +126,13 @@ struct DerivativeWorkspace<ChainT, true> {
   typename detail::PerFrame<ChainT, detail::FrameInWorld>::type frames;
   /// ... and the composite of the segments from it to the tip.
   typename detail::PerFrame<ChainT, detail::SubtreeComposite>::type subtrees;
-  /// Per coordinate (row), the world Jacobian of its segment's distal frame, transposed: a
-  /// wrench at the world origin -> its generalised forces.
-  Eigen::Matrix<double, kNq, 6> jacobian_t;
-  /// Per coordinate (row), the sensitivities (P | R) of its generalised force to a perturbation
-  /// of its segment's base: d tau = P a~ + R dV_angular (derivative_composites.hpp).
-  Eigen::Matrix<double, kNq, 9> sensitivity;
+  /// Per coordinate (column), the world Jacobian of its segment's distal frame: its twist
+  /// about the world origin for a unit rate.
+  Eigen::Matrix<double, 6, kNq> jacobian;
+  /// Per coordinate (column), the sensitivities (P | R)^T of its generalised force to a
+  /// perturbation of its segment's base: d tau = P a~ + R dV_angular
+  /// (derivative_composites.hpp).
+  Eigen::Matrix<double, 9, kNq> sensitivity;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 

@@ -178,7 +178,7 @@ SOFTRNE_SIM_INLINE bool ArmJacobian::differentiate(const Eigen::Ref<const Eigen:
     if (!xdot_.allFinite()) return false;
     const int nq = desc_.nq;
     detail::rnea_derivative_passes(f_.chain(), id_data_, x.head(nq), x.segment(nq, nq),
-                                   f_.data().qddot);
+                                   f_.data().qddot, false);
   }
   for (int start = 0; start < ncols; start += kBlock) {
     seed(x, p, start);

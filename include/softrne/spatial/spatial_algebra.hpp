@@ -18,19 +18,19 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;  ///< a spatial vector (linear; an
 
 /// \brief \f$v \times m\f$ of two motions:
 /// \f$(\omega\times m_v + v_O\times m_\omega;\ \omega\times m_\omega)\f$.
-inline Vector6d cross_motion(const Vector6d& v, const Vector6d& m) {
+EIGEN_ALWAYS_INLINE Vector6d cross_motion(const Vector6d& v, const Vector6d& m) {
   Vector6d out;
-  out.head<3>() = v.tail<3>().cross(m.head<3>()) + v.head<3>().cross(m.tail<3>());
-  out.tail<3>() = v.tail<3>().cross(m.tail<3>());
+  out.head<3>() = cross3(v.tail<3>(), m.head<3>()) + cross3(v.head<3>(), m.tail<3>());
+  out.tail<3>() = cross3(v.tail<3>(), m.tail<3>());
   return out;
 }
 
 /// \brief \f$v \times^* f\f$ of a motion and a force:
 /// \f$(\omega\times f;\ \omega\times n + v_O\times f)\f$.
-inline Vector6d cross_force(const Vector6d& v, const Vector6d& f) {
+EIGEN_ALWAYS_INLINE Vector6d cross_force(const Vector6d& v, const Vector6d& f) {
   Vector6d out;
-  out.head<3>() = v.tail<3>().cross(f.head<3>());
-  out.tail<3>() = v.tail<3>().cross(f.tail<3>()) + v.head<3>().cross(f.head<3>());
+  out.head<3>() = cross3(v.tail<3>(), f.head<3>());
+  out.tail<3>() = cross3(v.tail<3>(), f.tail<3>()) + cross3(v.head<3>(), f.head<3>());
   return out;
 }
 
@@ -38,7 +38,7 @@ inline Vector6d cross_force(const Vector6d& v, const Vector6d& f) {
 /// world), as seen about the world origin in world axes: \f$(R v + p\times R\omega;\ R\omega)\f$.
 /// Columnwise for a 6 x k block.
 template <class In>
-Eigen::Matrix<double, 6, In::ColsAtCompileTime> motion_to_world(const Eigen::Matrix3d& R,
+EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> motion_to_world(const Eigen::Matrix3d& R,
                                                                 const Eigen::Vector3d& p,
                                                                 const Eigen::MatrixBase<In>& m) {
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, m.cols());
@@ -51,7 +51,7 @@ Eigen::Matrix<double, 6, In::ColsAtCompileTime> motion_to_world(const Eigen::Mat
 /// \brief A force (f; n about the frame's origin) in a frame's own axes, as seen about the
 /// world origin in world axes: \f$(R f;\ R n + p\times R f)\f$. Columnwise for a 6 x k block.
 template <class In>
-Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_world(const Eigen::Matrix3d& R,
+EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_world(const Eigen::Matrix3d& R,
                                                                const Eigen::Vector3d& p,
                                                                const Eigen::MatrixBase<In>& f) {
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, f.cols());
@@ -64,7 +64,7 @@ Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_world(const Eigen::Matr
 /// \brief The inverse of force_to_world: a world force about the world origin in the frame's
 /// axes about its origin, \f$(R^T f;\ R^T(n - p\times f))\f$.
 template <class In>
-Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_local(const Eigen::Matrix3d& R,
+EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_local(const Eigen::Matrix3d& R,
                                                                const Eigen::Vector3d& p,
                                                                const Eigen::MatrixBase<In>& f) {
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, f.cols());
