@@ -742,8 +742,8 @@ NB_MODULE(_softrne, m) {
         });
       },
       "q"_a, "qd"_a, "qdd"_a, "threads"_a = 0,
-      (std::string("The partial derivatives of rnea (softrne::rnea_derivatives, exact: forward-mode AutoDiff "
-                   "through the RNE), stacked as shape (3, nq, nq): d tau/d q, d tau/d qd, d tau/d qdd = M(q).") +
+      (std::string("The partial derivatives of rnea (softrne::rnea_derivatives, exact: world-frame composites "
+                   "and AutoDiff on each perturbed CC segment), stacked as shape (3, nq, nq): d tau/d q, d tau/d qd, d tau/d qdd = M(q).") +
        kThreadsDoc)
           .c_str());
   robot.def(

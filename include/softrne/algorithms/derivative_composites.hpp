@@ -186,14 +186,13 @@ void own_body_composite(const Segment& seg, const typename Segment::Kinematics& 
     }
     own.add(b);
   };
-  if constexpr (num_sub_bodies<Segment> > 0) {
+  if constexpr (num_sub_bodies < Segment >> 0) {
     (void)seg;
     (void)load;
     (void)distal;
     (void)inertia_rate;
     for (const auto& b : kin.sub_bodies)
-      add_body(b.mass, b.r_base_body, rotate_symmetric(base.R, b.inertia), b.J_v, b.J_w,
-               nullptr);
+      add_body(b.mass, b.r_base_body, rotate_symmetric(base.R, b.inertia), b.J_v, b.J_w, nullptr);
   } else if constexpr (Segment::has_body) {
     const bool rate = nq > 0 && inertia_rate == InertiaRate::Consistent;
     Matrix3 rate_world;

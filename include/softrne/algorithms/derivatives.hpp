@@ -36,8 +36,8 @@
 /// and the partials of ID by the same passes as rnea_derivatives.
 
 #include <limits>
-#include <type_traits>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <variant>
 
@@ -87,8 +87,8 @@ void prepare_derivatives(const DynamicChain<Scalar>& chain,
     ws.jacobian.resize(6, nq);
     ws.sensitivity.resize(9, nq);
   }
-  for (auto* m : {&data.dtau_dq, &data.dtau_dqdot, &data.dqddot_dq, &data.dqddot_dqdot,
-                  &data.dqddot_dtau})
+  for (auto* m :
+       {&data.dtau_dq, &data.dtau_dqdot, &data.dqddot_dq, &data.dqddot_dqdot, &data.dqddot_dtau})
     m->resize(nq, nq);  // no-op after the first call
 }
 
@@ -198,10 +198,13 @@ void fixed_axis_derivatives(Data& data, int s, int i) {
 /// derivative_composites.hpp elsewhere); tau itself into data.tau, the RNE's kinematics,
 /// motions, loads and wrenches at that point into data, and with `with_mass_matrix`
 /// \f$\partial\tau/\partial\ddot q = M\f$ from the same composites into data.mass_matrix.
+/// `kinematics_ready`: data's kinematics are already those at (q, qdot) (forward_dynamics()
+/// just ran on data), so they are not computed again.
 template <class ChainT, class Q, class Qd, class Qdd>
 void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
                             const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
-                            const Eigen::MatrixBase<Qdd>& qddot, bool with_mass_matrix) {
+                            const Eigen::MatrixBase<Qdd>& qddot, bool with_mass_matrix,
+                            bool kinematics_ready = false) {
   static_assert(std::is_floating_point_v<typename ChainT::Scalar>,
                 "softrne: derivatives need a chain of a floating-point scalar");
   prepare_derivatives(chain, data);
@@ -211,7 +214,7 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
   const int nq = chain.num_coordinates(), n_seg = data.num_segments();
 
   // The expansion point, in double: what rnea() computes, kept in data.
-  compute_kinematics(chain, data, q, qdot);
+  if (!kinematics_ready) compute_kinematics(chain, data, q, qdot);
   rnea_passes(chain, data, qdot, qddot, true, true, data.tau);
   for (int i = 0; i < nq; ++i) {
     ws.q(i) = AD(q(i));
@@ -262,7 +265,8 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
         v += data.motion[k].omega.template cast<AD>().cross(kin.r_base_distal);
         if constexpr (n > 0)
           v += kin.J_distal.template topRows<3>() * segment_entries<n>(ws.qdot, offset);
-        const Tangent3 dv = derivatives_of(Eigen::Matrix<AD, 3, 1>(kin.R_base_distal.transpose() * v));
+        const Tangent3 dv =
+            derivatives_of(Eigen::Matrix<AD, 3, 1>(kin.R_base_distal.transpose() * v));
         const Tangent3 dw = derivatives_of(ws.data.motion[k + 1].omega);
         dV.template topRows<3>() = dv;
         dV.template bottomRows<3>() = dw;
@@ -288,14 +292,17 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
       const SubtreeComposite& beyond = ws.subtrees[k + 1];
       const Eigen::Matrix<double, 6, kDerivativeBlock> d_children =
           beyond.apply(x.template topRows<6>(), x.template bottomRows<3>());
-      const Eigen::Matrix<double, 6, kDerivativeBlock> d_local = force_to_local(distal.R, distal.p, d_children);
+      const Eigen::Matrix<double, 6, kDerivativeBlock> d_local =
+          force_to_local(distal.R, distal.p, d_children);
       // Segment s itself in AutoDiff, backward.
       Eigen::Matrix<double, 6, kDerivativeBlock> d_base;
       ws.chain.visit_segment(ws.data, s, [&](const auto& seg, const auto& kin, int, int) {
         constexpr int n = std::decay_t<decltype(seg)>::nq;
         Wrench<AD> children, base_wrench;
-        children.force = with_derivatives<AD>(data.wrench[k + 1].force, d_local.template topRows<3>());
-        children.torque = with_derivatives<AD>(data.wrench[k + 1].torque, d_local.template bottomRows<3>());
+        children.force =
+            with_derivatives<AD>(data.wrench[k + 1].force, d_local.template topRows<3>());
+        children.torque =
+            with_derivatives<AD>(data.wrench[k + 1].torque, d_local.template bottomRows<3>());
         Eigen::Matrix<AD, n, 1> tau;
         backward_step(seg, kin, ws.data.loads[k], children, rate, tau, base_wrench);
         if constexpr (n > 0) {  // (s has coordinates; the others are never visited here)
@@ -309,7 +316,8 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
       });
       // The coordinates before s: the wrench their segments transmit.
       if (s_offset > 0) {
-        const Eigen::Matrix<double, 6, kDerivativeBlock> d_world = force_to_world(base.R, base.p, d_base);
+        const Eigen::Matrix<double, 6, kDerivativeBlock> d_world =
+            force_to_world(base.R, base.p, d_base);
         for (int r = 0; r < s_offset; ++r) {
           data.dtau_dq(r, i) = ws.jacobian.col(r).dot(d_world.col(0));
           data.dtau_dqdot(r, i) = ws.jacobian.col(r).dot(d_world.col(1));
@@ -393,7 +401,8 @@ void aba_derivatives(const ChainT& chain, typename ChainT::Data& data,
     data.dqddot_dtau.setConstant(nan);
     return;
   }
-  detail::rnea_derivative_passes(chain, data, q, qdot, data.qddot, false);
+  // forward_dynamics left the kinematics at (q, qdot) in data.
+  detail::rnea_derivative_passes(chain, data, q, qdot, data.qddot, false, true);
   // M^-1 = L^-T L^-1 from the factor forward_dynamics left (cholesky.hpp), by Eigen's blocked
   // triangular solves (double only, so cholesky.hpp's reason to avoid them does not apply;
   // column by column was 16 us of 44 on the 30-joint chain), then the two products.

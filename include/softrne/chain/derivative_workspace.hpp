@@ -55,7 +55,7 @@ struct FrameInWorld {
 /// the composite of their velocity terms \f$D = \begin{pmatrix} 0 & -2[p]_\times\\ 0 &
 /// X\end{pmatrix}\f$, kept as their blocks.
 struct SubtreeComposite {
-  double mass = 0;                                        ///< m
+  double mass = 0;                                         ///< m
   Eigen::Vector3d first_moment = Eigen::Vector3d::Zero();  ///< h = sum of m c
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();       ///< I_O, about the world origin
   Eigen::Vector3d momentum = Eigen::Vector3d::Zero();      ///< p = sum of m v_c
@@ -63,13 +63,14 @@ struct SubtreeComposite {
 
   /// \brief Y a + D (0; dw), columnwise: the wrench's change for (a~; dV's angular part).
   template <class A, class W>
-  EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, A::ColsAtCompileTime> apply(const Eigen::MatrixBase<A>& a,
-                                                       const Eigen::MatrixBase<W>& dw) const {
+  EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, A::ColsAtCompileTime> apply(
+      const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<W>& dw) const {
     Eigen::Matrix<double, 6, A::ColsAtCompileTime> out(6, a.cols());
     for (Eigen::Index j = 0; j < a.cols(); ++j) {
       const Eigen::Vector3d lin = a.col(j).template head<3>(), ang = a.col(j).template tail<3>();
       const Eigen::Vector3d w = dw.col(j);
-      out.col(j).template head<3>() = mass * lin - cross3(first_moment, ang) - 2.0 * cross3(momentum, w);
+      out.col(j).template head<3>() =
+          mass * lin - cross3(first_moment, ang) - 2.0 * cross3(momentum, w);
       out.col(j).template tail<3>() = cross3(first_moment, lin);
       out.col(j).template tail<3>().noalias() += inertia * ang;
       out.col(j).template tail<3>().noalias() += velocity * w;
@@ -116,11 +117,11 @@ struct DerivativeWorkspace<ChainT, true> {
   using AD = DerivativeScalar<typename ChainT::Scalar>;  ///< the AutoDiff scalar
   /// The chain type in AD (Chain<...> of the same segment types, or DynamicChain<AD>).
   using ChainAD = decltype(std::declval<const ChainT&>().template cast<AD>());
-  ChainAD chain;                           ///< the chain's constants in AD (no derivatives)
-  typename ChainAD::Data data;             ///< the AD chain's workspace
-  typename ChainAD::VectorQ q;             ///< q of one pass, seeded
-  typename ChainAD::VectorQ qdot;          ///< qdot of one pass, seeded
-  typename ChainAD::VectorQ qddot;         ///< qddot (no derivatives)
+  ChainAD chain;                    ///< the chain's constants in AD (no derivatives)
+  typename ChainAD::Data data;      ///< the AD chain's workspace
+  typename ChainAD::VectorQ q;      ///< q of one pass, seeded
+  typename ChainAD::VectorQ qdot;   ///< qdot of one pass, seeded
+  typename ChainAD::VectorQ qddot;  ///< qddot (no derivatives)
   static constexpr int kNq = ChainT::VectorQ::RowsAtCompileTime;  ///< nq or Dynamic
   /// Per frame (frame k: segment k's base; the last: the tip): its pose and velocity...
   typename detail::PerFrame<ChainT, detail::FrameInWorld>::type frames;

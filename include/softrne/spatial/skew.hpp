@@ -34,7 +34,7 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<typename Derived::Scalar, 3, 3> skew(
 /// calls to it), which the derivatives' world composites make dozens of.
 template <class A, class B>
 EIGEN_ALWAYS_INLINE Eigen::Matrix<typename A::Scalar, 3, 1> cross3(const Eigen::MatrixBase<A>& a,
-                                                                  const Eigen::MatrixBase<B>& b) {
+                                                                   const Eigen::MatrixBase<B>& b) {
   Eigen::Matrix<typename A::Scalar, 3, 1> c;
   c(0) = a(1) * b(2) - a(2) * b(1);
   c(1) = a(2) * b(0) - a(0) * b(2);

@@ -38,9 +38,8 @@ EIGEN_ALWAYS_INLINE Vector6d cross_force(const Vector6d& v, const Vector6d& f) {
 /// world), as seen about the world origin in world axes: \f$(R v + p\times R\omega;\ R\omega)\f$.
 /// Columnwise for a 6 x k block.
 template <class In>
-EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> motion_to_world(const Eigen::Matrix3d& R,
-                                                                const Eigen::Vector3d& p,
-                                                                const Eigen::MatrixBase<In>& m) {
+EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> motion_to_world(
+    const Eigen::Matrix3d& R, const Eigen::Vector3d& p, const Eigen::MatrixBase<In>& m) {
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, m.cols());
   out.template bottomRows<3>().noalias() = R * m.template bottomRows<3>();
   out.template topRows<3>().noalias() = R * m.template topRows<3>();
@@ -51,9 +50,8 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> motion_to_wo
 /// \brief A force (f; n about the frame's origin) in a frame's own axes, as seen about the
 /// world origin in world axes: \f$(R f;\ R n + p\times R f)\f$. Columnwise for a 6 x k block.
 template <class In>
-EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_world(const Eigen::Matrix3d& R,
-                                                               const Eigen::Vector3d& p,
-                                                               const Eigen::MatrixBase<In>& f) {
+EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_world(
+    const Eigen::Matrix3d& R, const Eigen::Vector3d& p, const Eigen::MatrixBase<In>& f) {
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, f.cols());
   out.template topRows<3>().noalias() = R * f.template topRows<3>();
   out.template bottomRows<3>().noalias() = R * f.template bottomRows<3>();
@@ -64,9 +62,8 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_wor
 /// \brief The inverse of force_to_world: a world force about the world origin in the frame's
 /// axes about its origin, \f$(R^T f;\ R^T(n - p\times f))\f$.
 template <class In>
-EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_local(const Eigen::Matrix3d& R,
-                                                               const Eigen::Vector3d& p,
-                                                               const Eigen::MatrixBase<In>& f) {
+EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_local(
+    const Eigen::Matrix3d& R, const Eigen::Vector3d& p, const Eigen::MatrixBase<In>& f) {
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, f.cols());
   out.template topRows<3>().noalias() = R.transpose() * f.template topRows<3>();
   Eigen::Matrix<double, 3, In::ColsAtCompileTime> n = f.template bottomRows<3>();
