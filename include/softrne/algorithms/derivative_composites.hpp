@@ -32,7 +32,7 @@
 /// - a coordinate k beyond F changes by \f$P_k\tilde a + R_k\Delta V\f$, with
 ///   \f$P_k = \sum_m J_{k,m}^T Y_m\f$ and \f$R_k = \sum_m J_{k,m}^T D_m + E_k\f$ (E_k: the
 ///   \f$-\omega^T\partial_k I\f$ of its own lumped CC body) over the bodies it moves; neither
-///   depends on F, so one pass fills them for all perturbations (the sensitivity rows).
+///   depends on F, so one pass fills them for all perturbations (ws.sensitivity).
 /// A coordinate before F sees only the wrench its segment transmits: \f$\delta\tau_k =
 /// J_k^T\delta F\f$ (J_k: its distal frame's world Jacobian).
 ///

@@ -32,6 +32,9 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<typename Derived::Scalar, 3, 3> skew(
 /// \brief \f$a\times b\f$ of two 3-vectors, always inlined: GCC 12 leaves Eigen's cross() an
 /// out-of-line call (callgrind on rnea_derivatives: 4 300 instructions per call on rev6 in
 /// calls to it), which the derivatives' world composites make dozens of.
+/// \param[in] a A 3-vector.
+/// \param[in] b A 3-vector.
+/// \return Their cross product.
 template <class A, class B>
 EIGEN_ALWAYS_INLINE Eigen::Matrix<typename A::Scalar, 3, 1> cross3(const Eigen::MatrixBase<A>& a,
                                                                    const Eigen::MatrixBase<B>& b) {
