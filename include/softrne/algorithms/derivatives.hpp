@@ -13,7 +13,7 @@
 ///   (DerivativeScalar, two directions), the very code rnea() runs, on that segment alone;
 /// - **the coordinates after s** see their base's motion change: with the sensitivity rows of
 ///   derivative_composites.hpp (one O(n) pass for all blocks, in world quantities as
-///   Pinocchio's computeRNEADerivatives) each such row costs one 12-vector product;
+///   Pinocchio's computeRNEADerivatives) each such row costs one 9-vector product;
 /// - **the coordinates before s** see only the wrench s passes back: one 6-vector product each
 ///   with their world Jacobian; and s's own rows take the children's wrench from the
 ///   subtree's composite inertias (derivative_composites.hpp) into its AutoDiff backward step.
@@ -147,6 +147,29 @@ Eigen::Matrix<AD, 3, 1> with_derivatives(const Eigen::Vector3d& value, const Tan
   return v;
 }
 
+/// \brief Column i of \f$\partial\tau/\partial q\f$ and \f$\partial\tau/\partial\dot q\f$ for
+/// the coordinates from `first` on: their sensitivities (ws.sensitivity) to x = (a~; dV's
+/// angular part), one column per direction of the block (derivative_composites.hpp).
+template <class Data, class X>
+void store_coordinates_after(Data& data, int i, int first, const X& x) {
+  const auto& sensitivity = data.derivatives.sensitivity;
+  for (int r = first; r < static_cast<int>(data.dtau_dq.rows()); ++r) {
+    data.dtau_dq(r, i) = sensitivity.col(r).dot(x.col(0));
+    data.dtau_dqdot(r, i) = sensitivity.col(r).dot(x.col(1));
+  }
+}
+
+/// \brief The same for the coordinates before `end`: their world Jacobians (ws.jacobian)
+/// against the change dF of the wrench they transmit (world, about the world origin).
+template <class Data, class F>
+void store_coordinates_before(Data& data, int i, int end, const F& dF) {
+  const auto& jacobian = data.derivatives.jacobian;
+  for (int r = 0; r < end; ++r) {
+    data.dtau_dq(r, i) = jacobian.col(r).dot(dF.col(0));
+    data.dtau_dqdot(r, i) = jacobian.col(r).dot(dF.col(1));
+  }
+}
+
 /// \brief The columns (q_i, qdot_i) of \f$\partial\tau\f$ for the coordinate i of a fixed-axis
 /// joint s (is_fixed_axis_joint), in closed form from the composites (as Pinocchio's
 /// computeRNEADerivatives for its revolute joints). With S its world Jacobian, V_b and A_b its
@@ -173,11 +196,7 @@ void fixed_axis_derivatives(Data& data, int s, int i) {
   x.template topRows<6>().col(0) = cross_motion(base.acceleration, S) + cross_motion(V, dV.col(0));
   x.template topRows<6>().col(1) = 2.0 * dV.col(0);
   x.template bottomRows<3>() = dV.template bottomRows<3>();
-  const int nq = static_cast<int>(data.dtau_dq.rows());
-  for (int r = i; r < nq; ++r) {
-    data.dtau_dq(r, i) = ws.sensitivity.col(r).dot(x.col(0));
-    data.dtau_dqdot(r, i) = ws.sensitivity.col(r).dot(x.col(1));
-  }
+  store_coordinates_after(data, i, i, x);
   if (i > 0) {
     const SubtreeComposite& from_s = ws.subtrees[k];
     Eigen::Matrix<double, 6, kDerivativeBlock> dF =
@@ -185,10 +204,7 @@ void fixed_axis_derivatives(Data& data, int s, int i) {
     Vector6d F;
     F << data.wrench[k].force, data.wrench[k].torque;
     dF.col(0) += cross_force(S, force_to_world(base.R, base.p, F));
-    for (int r = 0; r < i; ++r) {
-      data.dtau_dq(r, i) = ws.jacobian.col(r).dot(dF.col(0));
-      data.dtau_dqdot(r, i) = ws.jacobian.col(r).dot(dF.col(1));
-    }
+    store_coordinates_before(data, i, i, dF);
   }
 }
 
@@ -283,11 +299,7 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
       for (int c = 0; c < kDerivativeBlock; ++c)
         x.template topRows<6>().col(c) += cross_motion(distal.twist, delta_V.col(c));
       x.template bottomRows<3>() = delta_V.template bottomRows<3>();
-      // The coordinates after s: their sensitivity rows.
-      for (int r = s_end; r < nq; ++r) {
-        data.dtau_dq(r, i) = ws.sensitivity.col(r).dot(x.col(0));
-        data.dtau_dqdot(r, i) = ws.sensitivity.col(r).dot(x.col(1));
-      }
+      store_coordinates_after(data, i, s_end, x);
       // The wrench of everything after s, in s's distal axes about its origin.
       const SubtreeComposite& beyond = ws.subtrees[k + 1];
       const Eigen::Matrix<double, 6, kDerivativeBlock> d_children =
@@ -315,14 +327,8 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
         d_base.template bottomRows<3>() = derivatives_of(base_wrench.torque);
       });
       // The coordinates before s: the wrench their segments transmit.
-      if (s_offset > 0) {
-        const Eigen::Matrix<double, 6, kDerivativeBlock> d_world =
-            force_to_world(base.R, base.p, d_base);
-        for (int r = 0; r < s_offset; ++r) {
-          data.dtau_dq(r, i) = ws.jacobian.col(r).dot(d_world.col(0));
-          data.dtau_dqdot(r, i) = ws.jacobian.col(r).dot(d_world.col(1));
-        }
-      }
+      if (s_offset > 0)
+        store_coordinates_before(data, i, s_offset, force_to_world(base.R, base.p, d_base));
 
       ws.q(i).derivatives().setZero();
       ws.qdot(i).derivatives().setZero();
