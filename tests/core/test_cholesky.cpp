@@ -1,13 +1,12 @@
 // The written-out Cholesky of algorithms/cholesky.hpp (forward_dynamics, aba's articulated
 // inertias) against Eigen's LLT and the matrix inverse, and the reason it is written out:
 // AutoDiff derivatives survive right-hand-side entries whose value is exactly zero.
-#include <gtest/gtest.h>
-
 #include <random>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <gtest/gtest.h>
 #include <unsupported/Eigen/AutoDiff>
 
 #include "softrne/algorithms/articulated_body.hpp"
@@ -72,6 +71,29 @@ TEST(Cholesky, KeepsAutoDiffDerivativesOfExactlyZeroRightHandSides) {
     dx.row(i) = b(i).derivatives().transpose();
   }
   EXPECT_LT((dx - A.inverse()).norm(), 1e-12 * A.inverse().norm());
+}
+
+// The inverse from the factor (aba_derivatives' M^-1) against Eigen's LU inverse, for sizes
+// around the chains benchmarked (6, 30), into a dynamic and a fixed-size matrix; both
+// triangles written and exactly symmetric.
+TEST(Cholesky, InverseFromTheFactorIsTheInverse) {
+  std::mt19937 rng(5);
+  for (int n : {1, 2, 3, 6, 7, 17, 30, 31}) {
+    const MatrixXd A = random_spd(n, rng);
+    MatrixXd L = A;
+    ASSERT_TRUE(softrne::detail::cholesky_factor_in_place(L)) << n;
+    L.triangularView<Eigen::StrictlyUpper>().setConstant(42.0);  // not read
+    MatrixXd inverse = MatrixXd::Constant(n, n, -7.0);
+    softrne::detail::cholesky_inverse_factored(L, inverse);
+    const MatrixXd expected = A.inverse();
+    EXPECT_LT((inverse - expected).norm(), 1e-12 * expected.norm() * A.norm()) << n;
+    EXPECT_EQ(inverse, MatrixXd(inverse.transpose())) << n;
+  }
+  const MatrixXd A = random_spd(30, rng);
+  Eigen::Matrix<double, 30, 30> L = A, inverse;
+  ASSERT_TRUE(softrne::detail::cholesky_factor_in_place(L));
+  softrne::detail::cholesky_inverse_factored(L, inverse);
+  EXPECT_LT((MatrixXd(inverse) - A.inverse()).norm(), 1e-12 * A.inverse().norm() * A.norm());
 }
 
 // aba's inverse of a segment's articulated inertia: closed forms for n = 1, 2, the Cholesky

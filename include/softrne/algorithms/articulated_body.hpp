@@ -98,11 +98,7 @@ bool invert_spd_small(const MatD& D, MatDinv& Dinv) {
   } else {
     Eigen::Matrix<S, n, n> L = D;
     if (!cholesky_factor_in_place(L)) return false;
-    for (int c = 0; c < n; ++c) {  // column c of D^-1 (no zero skipping: cholesky.hpp)
-      Eigen::Matrix<S, n, 1> x = Eigen::Matrix<S, n, 1>::Unit(c);
-      cholesky_solve_factored(L, x);
-      for (int i = 0; i < n; ++i) Dinv(i, c) = x(i);
-    }
+    cholesky_inverse_factored(L, Dinv.template topLeftCorner<n, n>());
     return true;
   }
 }
