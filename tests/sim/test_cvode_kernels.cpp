@@ -78,6 +78,19 @@ TEST(SerialVectorOps, AgreeWithSundialsSerialOperations) {
     N_VConst_Serial(b, ref.v);
     EXPECT_EQ(Eigen::VectorXd(ours.map()), Eigen::VectorXd(ref.map())) << n;
 
+    // The error weights' operations, exactly SUNDIALS' (one rounding each, or none).
+    ours.map() = x0;
+    ours.v->ops->nvabs(ours.v, ours.v);  // in place
+    N_VAbs_Serial(x.v, ref.v);
+    EXPECT_EQ(Eigen::VectorXd(ours.map()), Eigen::VectorXd(ref.map())) << n;
+    EXPECT_EQ(Eigen::VectorXd(ours.map()), Eigen::VectorXd(x0.cwiseAbs())) << n;
+    ours.v->ops->nvinv(x.v, ours.v);
+    N_VInv_Serial(x.v, ref.v);
+    EXPECT_EQ(Eigen::VectorXd(ours.map()), Eigen::VectorXd(ref.map())) << n;
+    ours.v->ops->nvaddconst(x.v, b, ours.v);
+    N_VAddConst_Serial(x.v, b, ref.v);
+    EXPECT_EQ(Eigen::VectorXd(ours.map()), Eigen::VectorXd(ref.map())) << n;
+
     ours.map() = x0;
     const double norm = ours.v->ops->nvwrmsnorm(ours.v, w.v);
     const double norm_ref = N_VWrmsNorm_Serial(x.v, w.v);
@@ -120,6 +133,7 @@ TEST(SerialVectorOps, ClonesKeepTheOperations) {
   ASSERT_NE(clone, nullptr);
   EXPECT_EQ(clone->ops->nvlinearsum, x.v->ops->nvlinearsum);
   EXPECT_EQ(clone->ops->nvwrmsnorm, x.v->ops->nvwrmsnorm);
+  EXPECT_EQ(clone->ops->nvabs, x.v->ops->nvabs);
   EXPECT_NE(clone->ops->nvlinearsum, &N_VLinearSum_Serial);
   N_VDestroy(clone);
 }
