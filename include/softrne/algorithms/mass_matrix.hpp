@@ -11,6 +11,7 @@
 #include "softrne/algorithms/rnea.hpp"
 #include "softrne/spatial/frame_placement.hpp"
 #include "softrne/spatial/inertia_transforms.hpp"
+#include "softrne/spatial/skew.hpp"
 
 namespace softrne {
 namespace detail {
@@ -79,10 +80,10 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
     // instead: its I_c joins the composite before the one rotation by R, its force m J_com
     // and its share m J_com^T J_com are formed per column below. Taking them from
     // own_body_inertia was measured 3-14 % slower on the lumped chains (an extra rotation
-    // and the 6 x n coupling per segment; rev6 1.12-1.14x, the paper's arm 1.08x); tests/core/test_articulated_body.cpp
-    // (OwnBodyInertia.*) checks the two against each other.
+    // and the 6 x n coupling per segment; rev6 1.12-1.14x, the paper's arm 1.08x);
+    // tests/core/test_articulated_body.cpp (OwnBodyInertia.*) checks the two against each other.
     constexpr bool lumped = Segment::has_body && num_sub_bodies<Segment> == 0;
-    constexpr bool sub_bodies = num_sub_bodies<Segment> > 0;
+    constexpr bool sub_bodies = num_sub_bodies < Segment >> 0;
     std::conditional_t<sub_bodies, OwnBodyInertia<Scalar, n>, NoOwnBlocks> own;
     if constexpr (sub_bodies) own_body_inertia(seg, kin, own);
     // Pending wrenches (about the distal origin): their orientation into the base frame's.
@@ -95,8 +96,8 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
       } else {
         for (int c = first_pending; c < nq; ++c) {
           const Vector3 f = P.col(c).template head<3>(), t = P.col(c).template tail<3>();
-          P.col(c).template head<3>() = R * f;
-          P.col(c).template tail<3>() = R * t;
+          P.col(c).template head<3>() = times(R, f);
+          P.col(c).template tail<3>() = times(R, t);
         }
       }
     }
@@ -137,12 +138,12 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
       for (int k = 0; k < n; ++k) {
         const Vector3 alpha = Jw.col(k);
         // Composite about the distal origin, own body about its centre of mass.
-        Vector3 f_s = alpha.cross(h);
-        Vector3 t = I_rot * alpha;
+        Vector3 f_s = cross3(alpha, h);
+        Vector3 t = times(I_rot, alpha);
         if constexpr (shifts) {
           const Vector3 a = Jv.col(k);
           f_s += c_mass * a;
-          t += h.cross(a);
+          t += cross3(h, a);
         }
         Vector3 f_b = Vector3::Zero();
         if constexpr (lumped) f_b = seg.mass * kin.J_com.col(k);
@@ -158,13 +159,14 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
         // its centre of mass).
         P.col(offset + k).template head<3>() = f_s + f_b;
         if constexpr (lumped)
-          P.col(offset + k).template tail<3>() = t + (kin.r_base_com - r_e).cross(f_b);
+          P.col(offset + k).template tail<3>() = t + cross3(kin.r_base_com - r_e, f_b);
         else
           P.col(offset + k).template tail<3>() = t;
         if constexpr (sub_bodies) {  // own wrench about the base origin -> distal origin
           const Vector3 f_own = own.coupling.col(k).template head<3>();
           P.col(offset + k).template head<3>() += f_own;
-          P.col(offset + k).template tail<3>() += own.coupling.col(k).template tail<3>() - r_e.cross(f_own);
+          P.col(offset + k).template tail<3>() +=
+              own.coupling.col(k).template tail<3>() - cross3(r_e, f_own);
         }
       }
       // The new wrenches (base orientation) into the pending ones' orientation.
@@ -172,8 +174,8 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
         for (int k = 0; k < n; ++k) {
           const Vector3 f = P.col(offset + k).template head<3>();
           const Vector3 t = P.col(offset + k).template tail<3>();
-          P.col(offset + k).template head<3>() = G.transpose() * f;
-          P.col(offset + k).template tail<3>() = G.transpose() * t;
+          P.col(offset + k).template head<3>() = transpose_times(G, f);
+          P.col(offset + k).template tail<3>() = transpose_times(G, t);
         }
       }
       first_pending = offset;
@@ -183,10 +185,10 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
     if constexpr (shifts) {
       if (first_pending < nq) {
         // r_e in the pending wrenches' orientation
-        const Vector3 r_p = lazy ? Vector3(G.transpose() * r_e) : r_e;
+        const Vector3 r_p = lazy ? transpose_times(G, r_e) : r_e;
         for (int c = first_pending; c < nq; ++c) {
           const Vector3 f = P.col(c).template head<3>();
-          P.col(c).template tail<3>() += r_p.cross(f);
+          P.col(c).template tail<3>() += cross3(r_p, f);
         }
       }
     }

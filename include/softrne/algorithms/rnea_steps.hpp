@@ -11,6 +11,7 @@
 #include "softrne/chain/motion.hpp"
 #include "softrne/segments/sub_bodies.hpp"
 #include "softrne/spatial/frame_placement.hpp"
+#include "softrne/spatial/skew.hpp"
 
 namespace softrne {
 namespace detail {
@@ -90,15 +91,16 @@ void forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
     load.force = seg.mass * acc_c;  // eq. 16 (gravity is in base.acc)
     // Eq. 18 in the distal frame, plus the rate of the configuration-dependent inertia.
     const auto& I = kin.inertia_com;
-    Vector3 torque = I * distal.alpha;
+    Vector3 torque = times(I, distal.alpha);
     if (velocity_terms) {
-      torque += distal.omega.cross(I * distal.omega);
+      torque += cross3(distal.omega, times(I, distal.omega));
       if constexpr (nq > 0) {
-        if (inertia_rate == InertiaRate::Consistent) torque += kin.inertia_rate * distal.omega;
+        if (inertia_rate == InertiaRate::Consistent)
+          torque += times(kin.inertia_rate, distal.omega);
       }
     }
     if constexpr (turns)
-      load.torque.noalias() = R * torque;
+      load.torque = times(R, torque);
     else
       load.torque = torque;
     load.omega_distal = velocity_terms ? distal.omega : Vector3::Zero();
@@ -170,7 +172,7 @@ void backward_step(const Segment&, const typename Segment::Kinematics& kin,
       tau.noalias() = kin.J_distal.template topRows<3>().transpose() * F;
       tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * N;
     }
-    if constexpr (num_sub_bodies<Segment> > 0) {
+    if constexpr (num_sub_bodies < Segment >> 0) {
       tau += load.tau_sub_bodies.template head<nq>();
     } else if constexpr (Segment::has_body) {
       tau.noalias() += kin.J_com.transpose() * load.force;
@@ -179,14 +181,14 @@ void backward_step(const Segment&, const typename Segment::Kinematics& kin,
         // -dT/dq_k of the rotational energy 1/2 w^T I(q) w.
         for (int k = 0; k < nq; ++k)
           tau(k) -=
-              Scalar(0.5) * load.omega_distal.dot(kin.dinertia_dq[static_cast<std::size_t>(k)] *
-                                                  load.omega_distal);
+              Scalar(0.5) * load.omega_distal.dot(times(
+                                kin.dinertia_dq[static_cast<std::size_t>(k)], load.omega_distal));
       }
     }
   }
   base.force = F;
   base.torque = X.shift_torque(N, F);
-  if constexpr (num_sub_bodies<Segment> > 0) {
+  if constexpr (num_sub_bodies < Segment >> 0) {
     base.force += load.force;
     base.torque += load.torque;  // already about the base origin
   } else if constexpr (Segment::has_body) {

@@ -14,8 +14,8 @@ namespace detail {
 /// \brief \f$R A R^T\f$ for symmetric A (upper triangle formed, then mirrored: the result is
 /// exactly symmetric).
 template <class Scalar>
-Eigen::Matrix<Scalar, 3, 3> rotate_symmetric(const Eigen::Matrix<Scalar, 3, 3>& R,
-                                             const Eigen::Matrix<Scalar, 3, 3>& A) {
+EIGEN_ALWAYS_INLINE Eigen::Matrix<Scalar, 3, 3> rotate_symmetric(
+    const Eigen::Matrix<Scalar, 3, 3>& R, const Eigen::Matrix<Scalar, 3, 3>& A) {
   const Eigen::Matrix<Scalar, 3, 3> RA = R * A;
   Eigen::Matrix<Scalar, 3, 3> B;
   for (int i = 0; i < 3; ++i)
@@ -31,8 +31,9 @@ Eigen::Matrix<Scalar, 3, 3> rotate_symmetric(const Eigen::Matrix<Scalar, 3, 3>& 
 /// origin at -r (bodies at rho become rho + r). With h = 0 (A about the centre of mass) it adds
 /// \f$-m[r]_\times^2 = m(|r|^2 1 - r r^T)\f$.
 template <class Scalar>
-void add_shift(Eigen::Matrix<Scalar, 3, 3>& A, const Eigen::Matrix<Scalar, 3, 1>& r,
-               const Eigen::Matrix<Scalar, 3, 1>& w) {
+EIGEN_ALWAYS_INLINE void add_shift(Eigen::Matrix<Scalar, 3, 3>& A,
+                                   const Eigen::Matrix<Scalar, 3, 1>& r,
+                                   const Eigen::Matrix<Scalar, 3, 1>& w) {
   const Scalar d = Scalar(2) * r.dot(w);
   for (int i = 0; i < 3; ++i)
     for (int j = i; j < 3; ++j) {
