@@ -1,6 +1,9 @@
 // csv.hpp must compile on its own: it is included first.
+#include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -393,6 +396,75 @@ TEST(IoCsv, WriteRejectsMismatchedShapes) {
   EXPECT_THROW(sio::write_trajectory_csv(temp_path("x.csv"), t, q3, {"u1"}), std::invalid_argument);
   EXPECT_THROW(sio::write_trajectory_csv(temp_path("x.csv"), t, q3, {"u1", "v,1"}),
                std::invalid_argument);
+}
+
+// csv_table.hpp's fast path for plain decimals against std::from_chars, bit for bit: random
+// doubles printed at 1-17 significant digits (fixed and %g), random digit strings with the
+// point anywhere (leading zeros, trailing zeros, "5.", ".5", -0), and strings it must leave
+// to from_chars (too many digits, mantissas above 2^53, exponents, junk). parse_number as a
+// whole must agree with from_chars on every one of them.
+TEST(IoCsv, PlainDecimalFastPathIsFromChars) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> mant(-1.0, 1.0);
+  std::uniform_int_distribution<int> exp10(-12, 12), ndig(1, 25), prec(1, 17), coin(0, 1);
+  std::vector<std::string> cases = {"0",
+                                    "-0",
+                                    "5.",
+                                    ".5",
+                                    "-.5",
+                                    "0.0",
+                                    "9007199254740992",
+                                    "9007199254740993",
+                                    "0.1",
+                                    "-0.153945",
+                                    "53474.6",
+                                    "1234567890123456789",
+                                    "12345678901234567890",
+                                    "1e5",
+                                    "inf",
+                                    "-",
+                                    ".",
+                                    "1.2.3",
+                                    "--5",
+                                    "0x10",
+                                    "1e-400"};
+  char buf[64];
+  for (int i = 0; i < 200000; ++i) {
+    const double v = mant(rng) * std::pow(10.0, exp10(rng));
+    std::snprintf(buf, sizeof buf, coin(rng) ? "%.*f" : "%.*g", prec(rng), v);
+    cases.emplace_back(buf);
+    std::string digits;
+    const int n = ndig(rng);
+    for (int d = 0; d < n; ++d) digits += static_cast<char>('0' + rng() % 10);
+    digits.insert(rng() % (digits.size() + 1), ".");
+    if (coin(rng)) digits.insert(0, "-");
+    cases.push_back(digits);
+  }
+  int fast = 0;
+  for (const auto& c : cases) {
+    const char* b = c.data();
+    const char* e = b + c.size();
+    double expected = 0.0;
+    const auto r = std::from_chars(b, e, expected, std::chars_format::general);
+    const bool whole = r.ec == std::errc() && r.ptr == e;
+    double got = 0.0;
+    if (softrne::io::detail::parse_plain_decimal(b, e, got)) {
+      ++fast;
+      ASSERT_TRUE(whole) << c;
+      ASSERT_EQ(std::memcmp(&got, &expected, sizeof got), 0)
+          << c << ": " << got << " vs " << expected;
+    }
+    double via_cell = 0.0;
+    const auto status = softrne::io::detail::parse_number(c, via_cell);
+    if (whole && std::isfinite(expected)) {
+      ASSERT_EQ(status, softrne::io::detail::NumberStatus::Ok) << c;
+      ASSERT_EQ(std::memcmp(&via_cell, &expected, sizeof via_cell), 0) << c;
+    }
+  }
+  // Most printed doubles take the fast path (a test of a path never taken could not fail).
+  EXPECT_GT(fast, static_cast<int>(cases.size() / 2));
+  std::printf("[ info ] %d of %zu strings parsed by the fast path, all as from_chars\n", fast,
+              cases.size());
 }
 
 TEST(IoCsv, HundredThousandRowsParseFast) {

@@ -13,11 +13,14 @@
 /// Nothing here knows a robot: the data sets of a robot (csv.hpp) build on it.
 
 #include <algorithm>
+#include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -37,8 +40,8 @@ inline constexpr std::size_t kMaxLineLength = std::size_t{1} << 20;
 /// \brief A numeric CSV table: every cell of every column is a finite number.
 struct Table {
   std::vector<std::string> header;  ///< the column names, in file order
-  Eigen::MatrixXd values;  ///< rows x cols, columns in header order
-  std::string source;      ///< the file, for messages
+  Eigen::MatrixXd values;           ///< rows x cols, columns in header order
+  std::string source;               ///< the file, for messages
 };
 
 /// \brief Index of column `name` in `table.header`, or -1.
@@ -76,6 +79,49 @@ inline void split_cells(std::string_view line, std::vector<std::string_view>& ce
   }
 }
 
+/// \brief Clinger's exact fast path for the plain decimals recordings are made of
+/// ([-]digits[.digits], e.g. "53474.6", "-0.153945"): with the digits as an integer m of at
+/// most 2^53 and k <= 22 digits after the point, m and 10^k are exact doubles, so the one
+/// division m / 10^k is the correctly rounded value, bit for bit what std::from_chars
+/// gives. Anything else (more digits, an exponent, "inf", stray characters) returns false
+/// and is left to std::from_chars.
+///
+/// Why: libstdc++'s from_chars cost 195 instructions per number, 5 % of a whole softrne-sim
+/// run on the tiled bundled test run (callgrind, 2026-12-07); this path costs a fraction
+/// (docs/performance.md). tests/io/test_csv.cpp holds it to from_chars on random decimals.
+/// \param[in] b The first character of the number (after any '+').
+/// \param[in] e One past its last character.
+/// \param[out] out The value, if true is returned.
+/// \return true if [b, e) is such a decimal and out holds its value.
+inline bool parse_plain_decimal(const char* b, const char* e, double& out) {
+  static_assert(std::numeric_limits<double>::is_iec559 && FLT_EVAL_METHOD == 0,
+                "the fast path needs IEEE double arithmetic without extended precision");
+  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                      1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                      1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const bool negative = b < e && *b == '-';
+  if (negative) ++b;
+  // The digits before and after the point, as one integer (it wraps beyond 19 digits, which
+  // are refused below anyway).
+  std::uint64_t m = 0;
+  const char* p = b;
+  auto digit = [&]() { return p < e && static_cast<unsigned>(*p - '0') <= 9u; };
+  for (; digit(); ++p) m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+  const std::ptrdiff_t before_point = p - b;
+  std::ptrdiff_t after_point = 0;
+  if (p < e && *p == '.') {
+    const char* first = ++p;
+    for (; digit(); ++p) m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+    after_point = p - first;
+  }
+  const std::ptrdiff_t digits = before_point + after_point;
+  if (p != e || digits == 0 || digits > 19 || m > (std::uint64_t(1) << 53) || after_point > 22)
+    return false;
+  const double v = static_cast<double>(m) / kPow10[after_point];
+  out = negative ? -v : v;
+  return true;
+}
+
 /// \brief Result of parsing one cell.
 enum class NumberStatus { Ok, Empty, NotANumber, NonFinite };
 
@@ -86,6 +132,7 @@ inline NumberStatus parse_number(std::string_view cell, double& out) {
   const char* b = cell.data();
   const char* e = b + cell.size();
   if (*b == '+' && e - b > 1 && (b[1] == '.' || (b[1] >= '0' && b[1] <= '9'))) ++b;
+  if (parse_plain_decimal(b, e, out)) return NumberStatus::Ok;
   const auto r = std::from_chars(b, e, out, std::chars_format::general);
   if (r.ec == std::errc::result_out_of_range && r.ptr == e) {
     // Overflow is an error; underflow reads as the nearest subnormal or zero.
