@@ -186,7 +186,7 @@ void own_body_composite(const Segment& seg, const typename Segment::Kinematics& 
     }
     own.add(b);
   };
-  if constexpr (num_sub_bodies < Segment >> 0) {
+  if constexpr (num_sub_bodies<Segment> > 0) {
     (void)seg;
     (void)load;
     (void)distal;

@@ -83,7 +83,7 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
     // and the 6 x n coupling per segment; rev6 1.12-1.14x, the paper's arm 1.08x);
     // tests/core/test_articulated_body.cpp (OwnBodyInertia.*) checks the two against each other.
     constexpr bool lumped = Segment::has_body && num_sub_bodies<Segment> == 0;
-    constexpr bool sub_bodies = num_sub_bodies < Segment >> 0;
+    constexpr bool sub_bodies = num_sub_bodies<Segment> > 0;
     std::conditional_t<sub_bodies, OwnBodyInertia<Scalar, n>, NoOwnBlocks> own;
     if constexpr (sub_bodies) own_body_inertia(seg, kin, own);
     // Pending wrenches (about the distal origin): their orientation into the base frame's.

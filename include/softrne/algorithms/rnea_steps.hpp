@@ -172,7 +172,7 @@ void backward_step(const Segment&, const typename Segment::Kinematics& kin,
       tau.noalias() = kin.J_distal.template topRows<3>().transpose() * F;
       tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * N;
     }
-    if constexpr (num_sub_bodies < Segment >> 0) {
+    if constexpr (num_sub_bodies<Segment> > 0) {
       tau += load.tau_sub_bodies.template head<nq>();
     } else if constexpr (Segment::has_body) {
       tau.noalias() += kin.J_com.transpose() * load.force;
@@ -188,7 +188,7 @@ void backward_step(const Segment&, const typename Segment::Kinematics& kin,
   }
   base.force = F;
   base.torque = X.shift_torque(N, F);
-  if constexpr (num_sub_bodies < Segment >> 0) {
+  if constexpr (num_sub_bodies<Segment> > 0) {
     base.force += load.force;
     base.torque += load.torque;  // already about the base origin
   } else if constexpr (Segment::has_body) {
