@@ -94,8 +94,9 @@ inline void split_cells(std::string_view line, std::vector<std::string_view>& ce
 /// \param[out] out The value, if true is returned.
 /// \return true if [b, e) is such a decimal and out holds its value.
 inline bool parse_plain_decimal(const char* b, const char* e, double& out) {
-  static_assert(std::numeric_limits<double>::is_iec559 && FLT_EVAL_METHOD == 0,
-                "the fast path needs IEEE double arithmetic without extended precision");
+  // Exact only with IEEE doubles and no extended-precision intermediates (x87): elsewhere
+  // every number goes to from_chars.
+  if constexpr (!(std::numeric_limits<double>::is_iec559 && FLT_EVAL_METHOD == 0)) return false;
   static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                       1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                       1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
