@@ -10,9 +10,9 @@
 /// instructions for one N_VLinearSum of 12 entries); the loops below do the same arithmetic in
 /// a fraction of that (docs/performance.md gives the numbers). N_VAbs, N_VInv and N_VAddConst
 /// (the error weights, once per step) followed on 2026-12-07: about 160 instructions each for
-/// 12 entries, 2.2 % of the run. CVODE clones its work vectors
-/// from the state vector with N_VClone, which copies the operations table, so setting them on
-/// the state vector before CVodeInit reaches every vector CVODE makes.
+/// 12 entries, 2.2 % of the run. CVODE clones its work vectors from the state vector with
+/// N_VClone, which copies the operations table, so setting them on the state vector before
+/// CVodeInit reaches every vector CVODE makes.
 ///
 /// Each operation computes what SUNDIALS documents for it (sundials_nvector.h); results
 /// differ from SUNDIALS' only in rounding (the order of the additions of a norm).
