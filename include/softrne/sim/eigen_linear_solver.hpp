@@ -13,8 +13,8 @@
 /// a smaller step, as it does for the SUNDIALS solver), solve overwrites x with A^-1 b.
 /// Nothing is allocated after make_eigen_dense_solver().
 ///
-/// Why solve by the explicit inverse, formed at setup from the factor (Eigen's solve of the
-/// identity): CVODE sets up far less often than it solves (the Newton matrix is kept up to 100
+/// Why solve by the explicit inverse, formed at setup from the factor (n solves of unit
+/// vectors): CVODE sets up far less often than it solves (the Newton matrix is kept up to 100
 /// steps, and one Newton iteration per step is the rule: 430 setups and 35.6k solves in the
 /// tiled bundled test run), and for the 12-state arm the product \f$A^{-1}b\f$ (Eigen's
 /// matrix-vector product) costs 0.68k instructions against 1.4k for the two triangular solves
@@ -45,6 +45,32 @@ struct EigenDenseLuContent {
   Eigen::VectorXd scratch;                  ///< A^-1 b during a solve
   sunindextype last_flag = 0;               ///< 0, or the 1-based column of a zero pivot
 };
+
+/// \brief y = A^-1 b by the factor P A = L U: y = P b, then L y = y (unit diagonal) and
+/// U y = y, column by column of the column-major factor. Written out, not Eigen's
+/// PartialPivLU::inverse() at setup: that allocates on the heap in the Debug build
+/// (Cvode.CallbacksDoNotAllocate failed in the sanitizer build when tried, 2026-12-07), and
+/// Eigen's triangular solvers for a runtime-size vector cost 1.6 times these loops.
+/// \param[in] c The solver's state after a successful setup.
+/// \param[in] b The right-hand side, n entries.
+/// \param[out] y The solution, n entries, distinct from b and from the factor.
+inline void lu_solve(const EigenDenseLuContent& c, const double* b, double* __restrict y) {
+  const Eigen::Index n = c.lu.rows();
+  const auto& perm = c.lu.permutationP().indices();
+  for (Eigen::Index i = 0; i < n; ++i) y[perm(i)] = b[i];
+  const double* __restrict LU = c.lu.matrixLU().data();
+  for (Eigen::Index j = 0; j < n; ++j) {  // L y = P b, unit diagonal
+    const double yj = y[j];
+    const double* col = LU + j * n;
+    for (Eigen::Index i = j + 1; i < n; ++i) y[i] -= col[i] * yj;
+  }
+  for (Eigen::Index j = n - 1; j >= 0; --j) {  // U x = y
+    const double* col = LU + j * n;
+    const double yj = y[j] / col[j];
+    y[j] = yj;
+    for (Eigen::Index i = 0; i < j; ++i) y[i] -= col[i] * yj;
+  }
+}
 
 inline EigenDenseLuContent& eigen_lu_content(SUNLinearSolver S) {
   return *static_cast<EigenDenseLuContent*>(S->content);
@@ -78,9 +104,12 @@ SOFTRNE_SIM_INLINE SUNLinearSolver make_eigen_dense_solver(sunindextype n, SUNCo
         c.last_flag = static_cast<sunindextype>(i + 1);  // as SUNLinSol_Dense reports it
         return static_cast<int>(SUNLS_LUFACT_FAIL);
       }
-    // A^-1 from the factor (see the file comment): setups are rare, so Eigen's solve of the
-    // identity (its triangular solves work on the stack for these sizes).
-    c.inverse = c.lu.inverse();
+    // A^-1 column by column (see the file comment); the scratch vector holds e_j.
+    for (Eigen::Index j = 0; j < n; ++j) {
+      c.scratch.setZero();
+      c.scratch(j) = 1.0;
+      lu_solve(c, c.scratch.data(), c.inverse.col(j).data());
+    }
     if (!c.inverse.allFinite()) {  // overflow of a nearly singular factor
       c.last_flag = static_cast<sunindextype>(n);
       return static_cast<int>(SUNLS_LUFACT_FAIL);
