@@ -3,10 +3,12 @@
 // physical identities of the RNE (C(q, qd) qd is quadratic in qd; qd' C qd = qd' Mdot qd / 2
 // from finite differences of M; M scales linearly with the masses), very large velocities,
 // tiny and huge masses, and the debug-build checks of API misuse (death tests).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -305,6 +307,70 @@ TEST(EdgeCases, StaticChainBeyondPiAgreesWithRuntimeChain) {
   const VectorXd tau_dyn = softrne::rnea(dyn, dd, VectorXd(q), VectorXd(qd), VectorXd(qdd));
   ASSERT_TRUE(tau.allFinite());
   EXPECT_LT((tau - tau_dyn).norm(), 1e-12 * tau.norm());
+}
+
+// A revolute joint about exactly x, y or z takes the placements' fast path
+// (spatial/axis_rotation.hpp): against its twin whose axis is off by 1e-150 (the general
+// products, the same physics to far below rounding), every algorithm agrees to rounding,
+// on a hybrid chain with axes +-x, +-y, +-z (-e_k takes the general path too).
+TEST(EdgeCases, RevoluteAboutCoordinateAxesAgreesWithTheGeneralPath) {
+  std::mt19937 rng(17);
+  DynamicChain<double> fast, general;
+  int fast_paths = 0;
+  for (int j = 0; j < 7; ++j) {
+    RevoluteJoint<double> r;
+    r.axis = Vector3d::Unit(j % 3) * (j == 4 ? -1.0 : 1.0);
+    r.stiffness = 0.5;
+    r.damping = 0.1;
+    RevoluteJoint<double> twin = r;
+    twin.axis((j + 1) % 3) = 1e-150;
+    EXPECT_EQ(r.coordinate_axis(), j == 4 ? -1 : j % 3);
+    EXPECT_EQ(twin.coordinate_axis(), -1);
+    fast_paths += r.coordinate_axis() >= 0;
+    fast.add(r);
+    general.add(twin);
+    if (j == 3) {  // a CC joint in the middle
+      fast.add(make_cc());
+      general.add(make_cc());
+    }
+    const Link l = make_link(0.5 + 0.2 * j, 0.1 + 0.02 * j);
+    fast.add(l);
+    general.add(l);
+  }
+  ASSERT_EQ(fast_paths, 6);
+  fast.gravity = general.gravity = Vector3d(0.3, -1.0, 9.81);
+  auto df = fast.make_data();
+  auto dg = general.make_data();
+  const int n = fast.num_coordinates();
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  auto random = [&] {
+    VectorXd v(n);
+    for (int i = 0; i < n; ++i) v(i) = u(rng);
+    return v;
+  };
+  auto close = [](const MatrixXd& a, const MatrixXd& b) {
+    return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+  };
+  for (int s = 0; s < 5; ++s) {
+    const VectorXd q = random(), qd = random(), qdd = random(), tau = random();
+    EXPECT_LT(close(softrne::rnea(fast, df, q, qd, qdd), softrne::rnea(general, dg, q, qd, qdd)),
+              1e-13);
+    EXPECT_LT(close(softrne::mass_matrix(fast, df, q), softrne::mass_matrix(general, dg, q)),
+              1e-13);
+    EXPECT_LT(close(softrne::aba(fast, df, q, qd, tau), softrne::aba(general, dg, q, qd, tau)),
+              1e-12);
+    EXPECT_LT(close(softrne::forward_dynamics(fast, df, q, qd, tau),
+                    softrne::forward_dynamics(general, dg, q, qd, tau)),
+              1e-12);
+    softrne::aba_derivatives(fast, df, q, qd, tau);
+    softrne::aba_derivatives(general, dg, q, qd, tau);
+    EXPECT_LT(close(df.dqddot_dq, dg.dqddot_dq), 1e-11);
+    EXPECT_LT(close(df.dqddot_dqdot, dg.dqddot_dqdot), 1e-11);
+    softrne::rnea_derivatives(fast, df, q, qd, qdd);
+    softrne::rnea_derivatives(general, dg, q, qd, qdd);
+    EXPECT_LT(close(df.dtau_dq, dg.dtau_dq), 1e-13);
+    EXPECT_LT(close(df.dtau_dqdot, dg.dtau_dqdot), 1e-13);
+  }
 }
 
 // --- misuse of a runtime chain: always-on checks (std::invalid_argument), also in Release --

@@ -22,6 +22,8 @@
 #include <variant>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "../core/autodiff_reference.hpp"
 #include "../core/support.hpp"
 #include "softrne/softrne.hpp"
@@ -321,6 +323,44 @@ TYPED_TEST(SegmentConformance, DeclaredPlacementShortcutsHold) {
         EXPECT_TRUE((k.Jdot_qdot_distal.template head<3>().array() == 0.0).all());
       }
     }
+  }
+}
+
+// A revolute joint about exactly x, y or z says so (RevoluteKinematics::coordinate_axis, the
+// placements' fast path, spatial/axis_rotation.hpp) and writes R with the exact zeros and one
+// that path assumes; R is Eigen's AngleAxis to rounding. Any other axis (-z, z off by 1e-150,
+// a random one) says -1.
+TEST(RevoluteJointAxis, CoordinateAxesGiveTheExactStructure) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> angle(-4.0, 4.0);
+  RevoluteJoint<double> r;
+  RevoluteJoint<double>::Kinematics k;
+  for (int axis = 0; axis < 3; ++axis) {
+    r.axis = Vector3d::Unit(axis);
+    for (int s = 0; s < 10; ++s) {
+      const double q = s == 0 ? 0.0 : angle(rng);
+      r.calc(Eigen::Matrix<double, 1, 1>(q), Eigen::Matrix<double, 1, 1>(0.0), k);
+      ASSERT_EQ(k.coordinate_axis, axis);
+      const Matrix3d R = Eigen::AngleAxisd(q, r.axis).toRotationMatrix();
+      EXPECT_LT((k.R_base_distal - R).cwiseAbs().maxCoeff(), 1e-15) << "axis " << axis;
+      EXPECT_EQ(k.R_base_distal(axis, axis), 1.0);
+      for (int i = 0; i < 3; ++i)
+        if (i != axis) {
+          EXPECT_EQ(k.R_base_distal(axis, i), 0.0);
+          EXPECT_EQ(k.R_base_distal(i, axis), 0.0);
+        }
+      EXPECT_EQ(k.J_distal, (Eigen::Matrix<double, 6, 1>() << 0, 0, 0, r.axis).finished());
+    }
+  }
+  const Vector3d others[] = {-Vector3d::UnitZ(), Vector3d(1e-150, 0.0, 1.0),
+                             Vector3d(0.3, -0.2, 1.0).normalized()};
+  for (const Vector3d& a : others) {
+    r.axis = a;
+    const double q = angle(rng);
+    r.calc(Eigen::Matrix<double, 1, 1>(q), Eigen::Matrix<double, 1, 1>(0.0), k);
+    EXPECT_EQ(k.coordinate_axis, -1) << a.transpose();
+    EXPECT_LT((k.R_base_distal - Eigen::AngleAxisd(q, a).toRotationMatrix()).cwiseAbs().maxCoeff(),
+              1e-15);
   }
 }
 

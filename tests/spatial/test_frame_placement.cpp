@@ -176,4 +176,56 @@ TEST(FramePlacement, ShortcutsGiveTheSameBits) {
   }
 }
 
+// The coordinate-axis fast path (spatial/axis_rotation.hpp) against the full products, with R
+// from Eigen's AngleAxis (not the revolute joint's code): vectors to the last bit (the skipped
+// terms are products with exact zeros), inertias to rounding, and every operation of a
+// placement that takes the path against one that does not.
+TEST(FramePlacement, CoordinateAxisFastPathIsTheFullProduct) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(-4.0, 4.0);
+  for (int s = 0; s < 30; ++s)
+    for (int k = 0; k < 3; ++k) {
+      // The structure the fast path assumes (exact ones and zeros in row and column k, as
+      // RevoluteJoint::calc writes; Eigen's AngleAxis leaves rounding there), checked against
+      // Eigen's rotation.
+      const double theta = angle(rng);
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      Matrix3 R = Matrix3::Identity();
+      R(i, i) = R(j, j) = std::cos(theta);
+      R(j, i) = std::sin(theta);
+      R(i, j) = -std::sin(theta);
+      ASSERT_LT(rel(R, Eigen::AngleAxisd(theta, Vector3::Unit(k)).toRotationMatrix()), 1e-15);
+      const Vector3 v = random_vector(rng), zero = Vector3::Zero();
+      const Matrix3 A = random_symmetric(rng);
+      const FramePlacement<double, true, false> full(R, zero);
+      const FramePlacement<double, true, false, true> fast(R, zero, k);
+      const FramePlacement<double, true, false, true> not_taken(R, zero, -1);
+      EXPECT_EQ(fast.rotate(v), full.rotate(v)) << "axis " << k;
+      EXPECT_EQ(fast.rotate_back(v), full.rotate_back(v)) << "axis " << k;
+      EXPECT_EQ(not_taken.rotate(v), full.rotate(v));
+      EXPECT_EQ(not_taken.rotate_symmetric(A), full.rotate_symmetric(A));
+      const Matrix3 B = fast.rotate_symmetric(A);
+      EXPECT_LT(rel(B, R * A * R.transpose()), 1e-15) << "axis " << k;
+      EXPECT_EQ(B, B.transpose());
+      // The placement's inertia operations take the same path.
+      RigidInertia<double> u, w;
+      u.mass = w.mass = 1.5;
+      u.first_moment = w.first_moment = random_vector(rng);
+      u.inertia = w.inertia = A;
+      fast.rotate(u);
+      full.rotate(w);
+      EXPECT_EQ(u.first_moment, w.first_moment);
+      EXPECT_LT(rel(u.inertia, w.inertia), 1e-15);
+      ArticulatedInertia<double> p, q;
+      p.A = q.A = random_symmetric(rng);
+      p.B = q.B = random_symmetric(rng);
+      p.C = q.C = random_symmetric(rng);
+      fast.to_base(p);
+      full.to_base(q);
+      EXPECT_LT(rel(p.A, q.A), 1e-15);
+      EXPECT_EQ(p.B, q.B);
+      EXPECT_LT(rel(p.C, q.C), 1e-15);
+    }
+}
+
 }  // namespace

@@ -69,7 +69,6 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
   chain.backward(data, [&](const auto& seg, const auto& kin, int, int offset) {
     using Segment = std::decay_t<decltype(seg)>;
     constexpr int n = Segment::nq;
-    const Matrix3& R = kin.R_base_distal;
     const Vector3& r_e = kin.r_base_distal;
 
     constexpr bool turns = !has_identity_rotation<Segment>::value;
@@ -86,24 +85,25 @@ void mass_matrix_passes(const ChainT& chain, typename ChainT::Data& data) {
     constexpr bool sub_bodies = num_sub_bodies<Segment> > 0;
     std::conditional_t<sub_bodies, OwnBodyInertia<Scalar, n>, NoOwnBlocks> own;
     if constexpr (sub_bodies) own_body_inertia(seg, kin, own);
-    // Pending wrenches (about the distal origin): their orientation into the base frame's.
+    // Pending wrenches (about the distal origin): their orientation into the base frame's
+    // (X.rotate: R's product, or its fast path about a coordinate axis).
+    const auto X = placement_of<Segment>(kin);
     if constexpr (turns) {
       if (lazy) {
-        G = R * G;
+        for (int c = 0; c < 3; ++c) G.col(c) = X.rotate(G.col(c));
       } else if (nq - first_pending > kRotateDirectly) {
-        G = R;
+        G = kin.R_base_distal;
         lazy = true;
       } else {
         for (int c = first_pending; c < nq; ++c) {
           const Vector3 f = P.col(c).template head<3>(), t = P.col(c).template tail<3>();
-          P.col(c).template head<3>() = times(R, f);
-          P.col(c).template tail<3>() = times(R, t);
+          P.col(c).template head<3>() = X.rotate(f);
+          P.col(c).template tail<3>() = X.rotate(t);
         }
       }
     }
     // The composite in the base orientation (about the distal origin), plus the own body's
     // inertia about its centre of mass: both turn with alpha alike.
-    const auto X = placement_of<Segment>(kin);
     if constexpr (lumped) composite.inertia += kin.inertia_com;
     X.rotate(composite);
     const Scalar& c_mass = composite.mass;

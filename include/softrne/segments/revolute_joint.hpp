@@ -7,9 +7,19 @@
 #include <Eigen/Core>
 
 #include "softrne/segments/segment_kinematics.hpp"
+#include "softrne/spatial/axis_rotation.hpp"
 #include "softrne/spatial/skew.hpp"
 
 namespace softrne {
+
+/// \brief A revolute joint's kinematics: the common record, plus which coordinate axis (if
+/// any) it turns about, for the placements' fast path (spatial/axis_rotation.hpp).
+template <class Scalar>
+struct RevoluteKinematics : SegmentKinematics<Scalar, 1> {
+  /// k if the axis is exactly base axis k (0, 1, 2; R then has R(k, k) = 1 and zeros in the
+  /// rest of row and column k), -1 for any other axis.
+  int coordinate_axis = -1;
+};
 
 /// \brief One coordinate q: rotation by q about `axis` (unit, base frame) at the origin; the
 /// distal frame origin coincides with the base one. Massless: mass comes from the links
@@ -27,9 +37,9 @@ struct RevoluteJoint {
   /// it in closed form, without AutoDiff (algorithms/derivatives.hpp; it takes the axis as unit,
   /// as the robot file must give it).
   static constexpr bool fixed_axis = true;
-  using Kinematics = SegmentKinematics<Scalar, nq>;  ///< what calc() fills
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;       ///< a 3-vector
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;       ///< a 3x3 matrix
+  using Kinematics = RevoluteKinematics<Scalar>;  ///< what calc() fills
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;    ///< a 3-vector
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;    ///< a 3x3 matrix
 
   Vector3 axis = Vector3::UnitZ();  ///< rotation axis, unit, in the base frame
   Scalar stiffness{0};  ///< N m/rad
@@ -58,6 +68,22 @@ struct RevoluteJoint {
     using std::cos;
     using std::sin;
     const Scalar c = cos(q(0)), s = sin(q(0));
+    // Constant Jacobian (J_v = 0: the origin does not move); its rate is zero.
+    kin.J_distal.template topRows<3>().setZero();
+    kin.J_distal.template bottomRows<3>() = axis;
+    kin.coordinate_axis = coordinate_axis();
+    if (kin.coordinate_axis >= 0) {  // about x, y or z: R turns one plane (i, j)
+      detail::with_axis(kin.coordinate_axis, [&](auto k) {
+        constexpr int i = detail::AxisPlane<k()>::I, j = detail::AxisPlane<k()>::J;
+        Matrix3& R = kin.R_base_distal;
+        R.setIdentity();
+        R(i, i) = c;
+        R(j, j) = c;
+        R(j, i) = s;
+        R(i, j) = -s;
+      });
+      return;
+    }
     // Rodrigues, R = I + s K + (1 - c) K^2 with K = [a]x, K^2 = a a^T - |a|^2 I, written per
     // component (no 3x3 product; same formula, so a non-unit axis gives what it gave before).
     const Scalar x = axis(0), y = axis(1), z = axis(2);
@@ -74,9 +100,15 @@ struct RevoluteJoint {
     R(0, 2) = txz + sy;
     R(1, 2) = tyz - sx;
     R(2, 2) = Scalar(1) - t * (x * x + y * y);
-    // Constant Jacobian (J_v = 0: the origin does not move); its rate is zero.
-    kin.J_distal.template topRows<3>().setZero();
-    kin.J_distal.template bottomRows<3>() = axis;
+  }
+
+  /// \return k if axis is exactly the unit vector of base axis k (0, 1, 2), else -1.
+  int coordinate_axis() const {
+    const Scalar zero(0), one(1);
+    if (axis(0) == zero && axis(1) == zero) return axis(2) == one ? 2 : -1;
+    if (axis(2) == zero && axis(0) == zero) return axis(1) == one ? 1 : -1;
+    if (axis(1) == zero && axis(2) == zero) return axis(0) == one ? 0 : -1;
+    return -1;
   }
 
   /// \brief The same joint in another scalar type.

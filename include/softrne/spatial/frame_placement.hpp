@@ -11,6 +11,9 @@
 /// rnea_steps.hpp, mass_matrix.hpp and articulated_body.hpp (as Pinocchio's transform types
 /// carry their own fast paths). With the flags on, every operation is the plain formula; the
 /// shortcuts give bit-identical results (a product by the identity, a zero cross product).
+/// A segment whose R may turn about a coordinate axis (a revolute joint about x, y or z) says
+/// which in its kinematics (`coordinate_axis`), and the products with R skip its zeros
+/// (spatial/axis_rotation.hpp): vectors bit-identical, inertias equal to rounding.
 ///
 /// Conventions (those of the RNE's backward step, eqs. 16-17): a wrench (f; n) is a force and
 /// a torque about a point; an inertia is kept as mass m, first moment h (about the origin)
@@ -18,10 +21,12 @@
 /// [A B; B^T C] acting on (linear acceleration of the origin; angular acceleration).
 
 #include <type_traits>
+#include <utility>
 
 #include <Eigen/Core>
 
 #include "softrne/chain/motion.hpp"
+#include "softrne/spatial/axis_rotation.hpp"
 #include "softrne/spatial/inertia_transforms.hpp"
 
 namespace softrne {
@@ -91,7 +96,10 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<Scalar, 3, 1> transpose_times(const Eigen::Mat
 /// inlined: a placement must cost what the hand-written products cost (see detail::times()).
 /// \tparam Turns false if R is the identity by construction.
 /// \tparam Shifts false if r is zero by construction.
-template <class Scalar, bool Turns = true, bool Shifts = true>
+/// \tparam AxisFastPath true if R may be a rotation about a coordinate axis, given at
+///   construction (spatial/axis_rotation.hpp): its products with vectors and inertias then
+///   skip R's zeros.
+template <class Scalar, bool Turns = true, bool Shifts = true, bool AxisFastPath = false>
 class FramePlacement {
  public:
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;  ///< a 3x3 matrix
@@ -101,7 +109,10 @@ class FramePlacement {
 
   /// \param[in] R The distal axes in base axes (kept by reference).
   /// \param[in] r The distal origin in the base frame (kept by reference).
-  FramePlacement(const Matrix3& R, const Vector3& r) : R_(R), r_(r) {}
+  /// \param[in] coordinate_axis k if R is a rotation about base axis k (0, 1, 2), else -1;
+  ///   only read with AxisFastPath.
+  FramePlacement(const Matrix3& R, const Vector3& r, int coordinate_axis = -1)
+      : R_(R), r_(r), axis_(coordinate_axis) {}
 
   /// \return R.
   const Matrix3& rotation() const { return R_; }
@@ -113,6 +124,10 @@ class FramePlacement {
   /// \return R v.
   template <class V>
   EIGEN_ALWAYS_INLINE Vector3 rotate(const Eigen::MatrixBase<V>& v) const {
+    if constexpr (AxisFastPath) {
+      if (axis_ >= 0)
+        return detail::with_axis(axis_, [&](auto k) { return detail::times_about_axis<k()>(R_, v); });
+    }
     if constexpr (Turns) return detail::times(R_, v); else return v;
   }
 
@@ -121,6 +136,11 @@ class FramePlacement {
   /// \return R^T v.
   template <class V>
   EIGEN_ALWAYS_INLINE Vector3 rotate_back(const Eigen::MatrixBase<V>& v) const {
+    if constexpr (AxisFastPath) {
+      if (axis_ >= 0)
+        return detail::with_axis(
+            axis_, [&](auto k) { return detail::transpose_times_about_axis<k()>(R_, v); });
+    }
     if constexpr (Turns) return detail::transpose_times(R_, v); else return v;
   }
 
@@ -180,9 +200,21 @@ class FramePlacement {
   /// \param[in,out] I The inertia, turned in place.
   void rotate(RigidInertia<Scalar>& I) const {
     if constexpr (Turns) {
-      I.first_moment = detail::times(R_, I.first_moment);
-      I.inertia = detail::rotate_symmetric(R_, I.inertia);
+      I.first_moment = rotate(I.first_moment);
+      I.inertia = rotate_symmetric(I.inertia);
     }
+  }
+
+  /// \brief A symmetric 3x3 tensor from distal axes into base axes.
+  /// \param[in] A Symmetric, in distal axes.
+  /// \return R A R^T, exactly symmetric.
+  EIGEN_ALWAYS_INLINE Matrix3 rotate_symmetric(const Matrix3& A) const {
+    if constexpr (AxisFastPath) {
+      if (axis_ >= 0)
+        return detail::with_axis(
+            axis_, [&](auto k) { return detail::rotate_symmetric_about_axis<k()>(R_, A); });
+    }
+    if constexpr (Turns) return detail::rotate_symmetric(R_, A); else return A;
   }
 
   /// \brief A rigid inertia about the distal origin in base axes, about the base origin
@@ -203,8 +235,8 @@ class FramePlacement {
   ///   symmetric).
   void to_base(ArticulatedInertia<Scalar>& I) const {
     if constexpr (Turns) {
-      I.A = detail::rotate_symmetric(R_, I.A);
-      I.C = detail::rotate_symmetric(R_, I.C);
+      I.A = rotate_symmetric(I.A);
+      I.C = rotate_symmetric(I.C);
       const Matrix3 BRt = I.B * R_.transpose();
       I.B.noalias() = R_ * BRt;
     }
@@ -225,6 +257,7 @@ class FramePlacement {
  private:
   const Matrix3& R_;
   const Vector3& r_;
+  int axis_;  // k if R turns about base axis k, else -1 (read with AxisFastPath only)
 };
 
 namespace detail {
@@ -247,13 +280,26 @@ template <class Segment>
 struct has_zero_translation<Segment, std::void_t<decltype(Segment::zero_translation)>>
     : std::bool_constant<Segment::zero_translation> {};
 
+/// \brief true if Segment's kinematics say whether R turns about a coordinate axis (a field
+/// `int coordinate_axis`, k or -1, as RevoluteKinematics has): placements then take the fast
+/// path of spatial/axis_rotation.hpp when it does.
+template <class Segment, class = void>
+struct has_coordinate_axis : std::false_type {};
+template <class Segment>
+struct has_coordinate_axis<
+    Segment, std::void_t<decltype(std::declval<typename Segment::Kinematics>().coordinate_axis)>>
+    : std::true_type {};
+
 /// \brief The placement of a segment's distal frame in its base frame, with the shortcuts its
 /// type declares. Refers to kin.
 template <class Segment>
 FramePlacement<typename Segment::Scalar, !has_identity_rotation<Segment>::value,
-               !has_zero_translation<Segment>::value>
+               !has_zero_translation<Segment>::value, has_coordinate_axis<Segment>::value>
 placement_of(const typename Segment::Kinematics& kin) {
-  return {kin.R_base_distal, kin.r_base_distal};
+  if constexpr (has_coordinate_axis<Segment>::value)
+    return {kin.R_base_distal, kin.r_base_distal, kin.coordinate_axis};
+  else
+    return {kin.R_base_distal, kin.r_base_distal};
 }
 
 }  // namespace detail
