@@ -81,22 +81,17 @@ class DynamicChain {
   /// \param[in] size The argument's size.
   /// \throws std::invalid_argument if size != num_coordinates().
   void check_argument(const char* algorithm, const char* argument, Eigen::Index size) const {
-    if (size != nq_)
-      throw std::invalid_argument(std::string("softrne::") + algorithm + ": " + argument + " has " +
-                                  std::to_string(size) + " entries; the chain has " +
-                                  std::to_string(nq_) + " coordinates");
+    if (size != nq_) throw_size_mismatch(algorithm, argument, size);
   }
   /// \brief Throws std::invalid_argument unless `data` was made by make_data() of a chain with
   /// this one's segments. Always on, like check_argument().
   /// \param[in] data The workspace to check.
   /// \throws std::invalid_argument if data has another number of segments or coordinates.
   void check_data(const Data& data) const {
+    // The test inline, the message out of line (throw_data_mismatch): every algorithm on a
+    // runtime chain starts here, and a 6-joint mass_matrix costs a few hundred instructions.
     if (data.kinematics.size() != segments_.size() || static_cast<int>(data.tau.size()) != nq_)
-      throw std::invalid_argument(
-          "softrne::DynamicChain: this Data was made for another chain (" +
-          std::to_string(data.kinematics.size()) + " segments, " + std::to_string(data.tau.size()) +
-          " coordinates; this chain has " + std::to_string(segments_.size()) + " and " +
-          std::to_string(nq_) + "; call make_data())");
+      throw_data_mismatch(data.kinematics.size(), data.tau.size());
   }
 
   /// \brief Calls f(segment, kinematics, index, q_offset) base to tip.
@@ -152,13 +147,32 @@ class DynamicChain {
           using Kin = typename std::decay_t<decltype(seg)>::Kinematics;
           // Same number of segments and coordinates but other types (a Data made for a
           // chain built in another order): a message here rather than bad_variant_access.
-          if (!std::holds_alternative<Kin>(data.kinematics[k]))
-            throw std::invalid_argument(
-                "softrne::DynamicChain: this Data was made for another chain (segment " +
-                std::to_string(i) + " has another type; call make_data())");
-          f(seg, std::get<Kin>(data.kinematics[k]), i, offsets_[k]);
+          Kin* kin = std::get_if<Kin>(&data.kinematics[k]);
+          if (kin == nullptr) throw_segment_mismatch(i);
+          f(seg, *kin, i, offsets_[k]);
         },
         segments_[k]);
+  }
+  // The messages of check_argument(), check_data() and visit(), out of line so that the
+  // checks themselves inline into the algorithms as a compare and a branch.
+  [[noreturn]] EIGEN_DONT_INLINE void throw_size_mismatch(const char* algorithm,
+                                                          const char* argument,
+                                                          Eigen::Index size) const {
+    throw std::invalid_argument(std::string("softrne::") + algorithm + ": " + argument + " has " +
+                                std::to_string(size) + " entries; the chain has " +
+                                std::to_string(nq_) + " coordinates");
+  }
+  [[noreturn]] EIGEN_DONT_INLINE void throw_data_mismatch(std::size_t segments,
+                                                          Eigen::Index coordinates) const {
+    throw std::invalid_argument(
+        "softrne::DynamicChain: this Data was made for another chain (" + std::to_string(segments) +
+        " segments, " + std::to_string(coordinates) + " coordinates; this chain has " +
+        std::to_string(segments_.size()) + " and " + std::to_string(nq_) + "; call make_data())");
+  }
+  [[noreturn]] static EIGEN_DONT_INLINE void throw_segment_mismatch(int i) {
+    throw std::invalid_argument(
+        "softrne::DynamicChain: this Data was made for another chain (segment " +
+        std::to_string(i) + " has another type; call make_data())");
   }
   std::vector<Segment> segments_;
   std::vector<std::string> names_;
