@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <Eigen/Geometry>
 
@@ -36,6 +37,19 @@ Vector3 random_vector(std::mt19937& rng) {
 Matrix3 random_symmetric(std::mt19937& rng) {
   const Matrix3 A = Matrix3::NullaryExpr([&] { return std::normal_distribution<double>()(rng); });
   return A + A.transpose();
+}
+
+// One random articulated inertia (symmetric blocks) moved to the base by two placements.
+template <class PlacementX, class PlacementY>
+std::pair<ArticulatedInertia<double>, ArticulatedInertia<double>> to_base_by_both(
+    const PlacementX& X, const PlacementY& Y, std::mt19937& rng) {
+  ArticulatedInertia<double> p, q;
+  p.A = q.A = random_symmetric(rng);
+  p.B = q.B = random_symmetric(rng);
+  p.C = q.C = random_symmetric(rng);
+  X.to_base(p);
+  Y.to_base(q);
+  return {p, q};
 }
 
 // Wrenches (f; n about the origin), linear first: the distal frame's wrench in the base frame
@@ -151,12 +165,7 @@ TEST(FramePlacement, ShortcutsGiveTheSameBits) {
       EXPECT_EQ(x.force, y.force);
       EXPECT_EQ(x.torque, y.torque);
       EXPECT_EQ(X.point_acceleration(a, om, al, true), Y.point_acceleration(a, om, al, true));
-      ArticulatedInertia<double> p, q;
-      p.A = q.A = random_symmetric(rng);
-      p.B = q.B = random_symmetric(rng);
-      p.C = q.C = random_symmetric(rng);
-      X.to_base(p);
-      Y.to_base(q);
+      const auto [p, q] = to_base_by_both(X, Y, rng);
       EXPECT_EQ(p.A, q.A);
       EXPECT_EQ(p.B, q.B);
       EXPECT_EQ(p.C, q.C);
@@ -216,12 +225,7 @@ TEST(FramePlacement, CoordinateAxisFastPathIsTheFullProduct) {
       full.rotate(w);
       EXPECT_EQ(u.first_moment, w.first_moment);
       EXPECT_LT(rel(u.inertia, w.inertia), 1e-15);
-      ArticulatedInertia<double> p, q;
-      p.A = q.A = random_symmetric(rng);
-      p.B = q.B = random_symmetric(rng);
-      p.C = q.C = random_symmetric(rng);
-      fast.to_base(p);
-      full.to_base(q);
+      const auto [p, q] = to_base_by_both(fast, full, rng);
       EXPECT_LT(rel(p.A, q.A), 1e-15);
       EXPECT_EQ(p.B, q.B);
       EXPECT_LT(rel(p.C, q.C), 1e-15);

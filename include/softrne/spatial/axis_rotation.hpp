@@ -28,27 +28,19 @@ struct AxisPlane {
   static constexpr int J = (K + 2) % 3;  ///< second axis of the plane
 };
 
-/// \brief \f$R v\f$ for R a rotation about axis K (see the file comment).
-template <int K, class Scalar, class V>
+/// \brief \f$R v\f$ (or \f$R^T v\f$ with Transpose) for R a rotation about axis K (see the
+/// file comment).
+template <int K, bool Transpose = false, class Scalar, class V>
 EIGEN_ALWAYS_INLINE Eigen::Matrix<Scalar, 3, 1> times_about_axis(
     const Eigen::Matrix<Scalar, 3, 3>& R, const Eigen::MatrixBase<V>& v) {
   constexpr int i = AxisPlane<K>::I, j = AxisPlane<K>::J;
+  // The plane's off-diagonal entries: (i, j) and (j, i) of R, swapped for R^T.
+  const Scalar& r_ij = Transpose ? R(j, i) : R(i, j);
+  const Scalar& r_ji = Transpose ? R(i, j) : R(j, i);
   Eigen::Matrix<Scalar, 3, 1> out;
   out(K) = v(K);
-  out(i) = R(i, i) * v(i) + R(i, j) * v(j);
-  out(j) = R(j, i) * v(i) + R(j, j) * v(j);
-  return out;
-}
-
-/// \brief \f$R^T v\f$ for R a rotation about axis K (see the file comment).
-template <int K, class Scalar, class V>
-EIGEN_ALWAYS_INLINE Eigen::Matrix<Scalar, 3, 1> transpose_times_about_axis(
-    const Eigen::Matrix<Scalar, 3, 3>& R, const Eigen::MatrixBase<V>& v) {
-  constexpr int i = AxisPlane<K>::I, j = AxisPlane<K>::J;
-  Eigen::Matrix<Scalar, 3, 1> out;
-  out(K) = v(K);
-  out(i) = R(i, i) * v(i) + R(j, i) * v(j);
-  out(j) = R(i, j) * v(i) + R(j, j) * v(j);
+  out(i) = R(i, i) * v(i) + r_ij * v(j);
+  out(j) = r_ji * v(i) + R(j, j) * v(j);
   return out;
 }
 

@@ -139,7 +139,7 @@ class FramePlacement {
     if constexpr (AxisFastPath) {
       if (axis_ >= 0)
         return detail::with_axis(
-            axis_, [&](auto k) { return detail::transpose_times_about_axis<k()>(R_, v); });
+            axis_, [&](auto k) { return detail::times_about_axis<k(), true>(R_, v); });
     }
     if constexpr (Turns) return detail::transpose_times(R_, v); else return v;
   }
