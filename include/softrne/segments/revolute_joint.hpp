@@ -59,12 +59,14 @@ struct RevoluteJoint {
   /// \return 0: no pressure inputs.
   int num_inputs() const { return 0; }
 
-  /// \brief Fills kin for the angle q: the rotation about axis (Rodrigues), a constant
-  /// Jacobian (angular part = axis) and a zero Jacobian rate.
+  /// \brief Fills kin for the angle q: the rotation about axis (Rodrigues; about x, y or z
+  /// with exact zeros, and kin.coordinate_axis says which), a constant Jacobian (angular part
+  /// = axis) and a zero Jacobian rate. Always inlined: small, and called once per joint by
+  /// every algorithm (a runtime chain's visit otherwise left it out of line).
   /// \param[in] q The joint angle, rad (the velocity is not needed).
   /// \param[out] kin The segment's kinematics.
   template <class Q, class Qd>
-  void calc(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>&, Kinematics& kin) const {
+  EIGEN_ALWAYS_INLINE void calc(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>&, Kinematics& kin) const {
     using std::cos;
     using std::sin;
     const Scalar c = cos(q(0)), s = sin(q(0));

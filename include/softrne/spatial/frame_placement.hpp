@@ -198,7 +198,7 @@ class FramePlacement {
   /// \brief A rigid inertia about the distal origin: its axes into the base's (about the same
   /// origin): h -> R h, I -> R I R^T.
   /// \param[in,out] I The inertia, turned in place.
-  void rotate(RigidInertia<Scalar>& I) const {
+  EIGEN_ALWAYS_INLINE void rotate(RigidInertia<Scalar>& I) const {
     if constexpr (Turns) {
       I.first_moment = rotate(I.first_moment);
       I.inertia = rotate_symmetric(I.inertia);
