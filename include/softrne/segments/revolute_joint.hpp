@@ -66,7 +66,8 @@ struct RevoluteJoint {
   /// \param[in] q The joint angle, rad (the velocity is not needed).
   /// \param[out] kin The segment's kinematics.
   template <class Q, class Qd>
-  EIGEN_ALWAYS_INLINE void calc(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>&, Kinematics& kin) const {
+  EIGEN_ALWAYS_INLINE void calc(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>&,
+                                Kinematics& kin) const {
     using std::cos;
     using std::sin;
     const Scalar c = cos(q(0)), s = sin(q(0));

@@ -126,7 +126,8 @@ class FramePlacement {
   EIGEN_ALWAYS_INLINE Vector3 rotate(const Eigen::MatrixBase<V>& v) const {
     if constexpr (AxisFastPath) {
       if (axis_ >= 0)
-        return detail::with_axis(axis_, [&](auto k) { return detail::times_about_axis<k()>(R_, v); });
+        return detail::with_axis(axis_,
+                                 [&](auto k) { return detail::times_about_axis<k()>(R_, v); });
     }
     if constexpr (Turns) return detail::times(R_, v); else return v;
   }
