@@ -186,9 +186,9 @@ TEST(FramePlacement, ShortcutsGiveTheSameBits) {
 }
 
 // The coordinate-axis fast path (spatial/axis_rotation.hpp) against the full products, with R
-// from Eigen's AngleAxis (not the revolute joint's code): vectors to the last bit (the skipped
-// terms are products with exact zeros), inertias to rounding, and every operation of a
-// placement that takes the path against one that does not.
+// written here (not by the revolute joint's code) and checked against Eigen's AngleAxis:
+// vectors to the last bit (the skipped terms are products with exact zeros), inertias to
+// rounding, and every operation of a placement that takes the path against one that does not.
 TEST(FramePlacement, CoordinateAxisFastPathIsTheFullProduct) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> angle(-4.0, 4.0);
