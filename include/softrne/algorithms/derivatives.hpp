@@ -9,15 +9,20 @@
 /// and a block changes the RNE in three ways that are handled apart:
 /// - **segment s itself** changes its kinematics (pose, Jacobians, their rates, its
 ///   configuration-dependent inertia and every series below the CC functions' switches): its
-///   `calc`, `forward_step` and `backward_step` run in forward-mode AutoDiff
-///   (DerivativeScalar, two directions), the very code rnea() runs, on that segment alone;
+///   `calc` runs in forward-mode AutoDiff (DerivativeScalar), the very code rnea() runs, on
+///   that segment alone. For a lumped CC joint (segment_tangent.hpp's has_tangent_steps) calc
+///   runs once, seeded along its coordinates, and the tangent steps of segment_tangent.hpp
+///   carry the result through its forward and backward step in double (its rates' directions
+///   follow from the same evaluation); any other segment runs calc, `forward_step` and
+///   `backward_step` in AutoDiff once per coordinate, seeded along (q_i, qdot_i);
 /// - **the coordinates after s** see their base's motion change: with the sensitivity rows of
 ///   derivative_composites.hpp (one O(n) pass for all blocks, in world quantities as
 ///   Pinocchio's computeRNEADerivatives) each such row costs one 9-vector product;
 /// - **the coordinates before s** see only the wrench s passes back: one 6-vector product each
 ///   with their world Jacobian; and s's own rows take the children's wrench from the
 ///   subtree's composite inertias (derivative_composites.hpp) into its AutoDiff backward step.
-/// So nq blocks cost nq AutoDiff evaluations of one segment plus O(nq) short products each.
+/// So nq blocks cost one AutoDiff evaluation of calc per lumped CC joint (of calc and both
+/// steps per coordinate for other segments) plus O(nq) short products each.
 /// Until 2026-12-07 the rest of the chain was walked segment by segment in local axes for
 /// every block (3 x 2 tangent steps, O(n) each, 2.2-8x Pinocchio); docs/performance.md has
 /// both. Exact to rounding (no step size), at phi = 0 and across the series switches, for
@@ -47,6 +52,7 @@
 #include "softrne/algorithms/derivative_composites.hpp"
 #include "softrne/algorithms/forward_dynamics.hpp"
 #include "softrne/algorithms/rnea.hpp"
+#include "softrne/algorithms/segment_tangent.hpp"
 #include "softrne/chain/derivative_workspace.hpp"
 #include "softrne/chain/dynamic_chain.hpp"
 #include "softrne/chain/static_chain.hpp"
@@ -208,6 +214,191 @@ void fixed_axis_derivatives(Data& data, int s, int i) {
   }
 }
 
+/// \brief The change (dV, dA) of segment s's distal twist and spatial acceleration in its own
+/// axes, one column per direction of block i, to the rows of the coordinates from `first` on
+/// (store_coordinates_after) and to the change of the wrench the children pass to s (returned,
+/// in s's distal axes about its origin).
+template <class Data>
+Eigen::Matrix<double, 6, kDerivativeBlock> distal_change_to_children(
+    Data& data, int s, int i, int first, const Eigen::Matrix<double, 6, kDerivativeBlock>& dV,
+    const Eigen::Matrix<double, 6, kDerivativeBlock>& dA) {
+  const auto& ws = data.derivatives;
+  const auto k = static_cast<std::size_t>(s);
+  const FrameInWorld& distal = ws.frames[k + 1];
+  // In the world, and a~ = dA + V x dV (derivative_composites.hpp).
+  const Eigen::Matrix<double, 6, kDerivativeBlock> delta_V =
+      motion_to_world(distal.R, distal.p, dV);
+  Eigen::Matrix<double, 9, kDerivativeBlock> x;  // (a~; dV's angular part)
+  x.template topRows<6>() = motion_to_world(distal.R, distal.p, dA);
+  for (int c = 0; c < kDerivativeBlock; ++c)
+    x.template topRows<6>().col(c) += cross_motion(distal.twist, delta_V.col(c));
+  x.template bottomRows<3>() = delta_V.template bottomRows<3>();
+  store_coordinates_after(data, i, first, x);
+  // The wrench of everything after s.
+  const Eigen::Matrix<double, 6, kDerivativeBlock> d_children =
+      ws.subtrees[k + 1].apply(x.template topRows<6>(), x.template bottomRows<3>());
+  return force_to_local(distal.R, distal.p, d_children);
+}
+
+/// \brief The columns (q_i, qdot_i) of \f$\partial\tau\f$ for the coordinates of a segment s
+/// with tangent steps (segment_tangent.hpp: a lumped CC joint): its calc() once in AutoDiff
+/// along its coordinates, then per coordinate the tangent steps in double, the rows after s and
+/// before s as for any segment (the file comment).
+template <class ChainT, class Segment, class Qd, class Qdd>
+void tangent_step_derivatives(const ChainT& chain, typename ChainT::Data& data, int s, int offset,
+                              const Segment& seg, const typename Segment::Kinematics& kin,
+                              const Eigen::MatrixBase<Qd>& qdot,
+                              const Eigen::MatrixBase<Qdd>& qddot) {
+  static_assert(has_tangent_steps<Segment, kDerivativeBlock>);
+  auto& ws = data.derivatives;
+  using AD = typename std::decay_t<decltype(ws)>::AD;
+  const InertiaRate rate = chain.inertia_rate;
+  const auto k = static_cast<std::size_t>(s);
+  constexpr int n = Segment::nq;
+  using SegmentAD = decltype(seg.template cast<AD>());
+  // calc() in AutoDiff, direction j along q_j.
+  segment_to_autodiff(chain, ws.chain, s);
+  for (int j = 0; j < n; ++j) ws.q(offset + j).derivatives() = AD::DerType::Unit(j);
+  const typename SegmentAD::Kinematics* kin_ad = nullptr;
+  ws.chain.visit_segment(ws.data, s, [&](const auto& seg_ad, auto& kin_s, int, int) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(seg_ad)>, SegmentAD>) {
+      seg_ad.calc(segment_entries<n>(ws.q, offset), segment_entries<n>(ws.qdot, offset), kin_s);
+      kin_ad = &kin_s;
+    }
+  });
+  for (int j = 0; j < n; ++j) ws.q(offset + j).derivatives().setZero();
+
+  const auto qd = segment_entries<n>(qdot, offset);
+  const auto qdd = segment_entries<n>(qddot, offset);
+  const FrameInWorld& base = ws.frames[k];
+  const FrameMotion<double>& base_motion = data.motion[k];
+  const FrameMotion<double>& distal_motion = data.motion[k + 1];
+  const auto& R = kin.R_base_distal;
+  // The distal origin's velocity in base axes, and both twists in distal axes.
+  Eigen::Vector3d v =
+      transpose_times(base.R, base.v) + cross3(base_motion.omega, kin.r_base_distal);
+  v.noalias() += kin.J_distal.template topRows<3>() * qd;
+  const Eigen::Vector3d v_d = transpose_times(R, v);
+  const Eigen::Vector3d& w_d = distal_motion.omega;
+  Wrench<double> d_children;
+  for (int j = 0; j < n; ++j) {
+    const int i = offset + j;  // the block: directions (q_i, qdot_i)
+    KinematicsTangent<n> t[kDerivativeBlock];
+    kinematics_tangents<n>(*kin_ad, kin, qd, j, t[0], t[1]);
+    FrameMotion<double> d_distal[kDerivativeBlock];
+    BodyLoad<double> d_load[kDerivativeBlock];
+    Eigen::Matrix<double, 6, kDerivativeBlock> dV, dA;
+    for (int c = 0; c < kDerivativeBlock; ++c) {
+      tangent_forward_step(seg, kin, base_motion, qd, qdd, rate, distal_motion, data.loads[k], t[c],
+                           d_distal[c], d_load[c]);
+      // (dv; dw) and (da - dw x v - w x dv; dalpha), distal axes, as derivatives.hpp's
+      // AutoDiff path forms them.
+      Eigen::Vector3d dv_base = cross3(base_motion.omega, t[c].r_e);
+      dv_base.noalias() += t[c].J.template topRows<3>() * qd;
+      dv_base.noalias() += kin.J_distal.template topRows<3>() * t[c].qdot;
+      const Eigen::Vector3d dv = transpose_times(t[c].R, v) + transpose_times(R, dv_base);
+      const Eigen::Vector3d& dw = d_distal[c].omega;
+      dV.col(c) << dv, dw;
+      dA.col(c) << d_distal[c].acc + cross3(v_d, dw) - cross3(w_d, dv), d_distal[c].alpha;
+    }
+    const Eigen::Matrix<double, 6, kDerivativeBlock> d_local =
+        distal_change_to_children(data, s, i, offset + n, dV, dA);
+    Eigen::Matrix<double, 6, kDerivativeBlock> d_base;
+    for (int c = 0; c < kDerivativeBlock; ++c) {
+      d_children.force = d_local.col(c).template head<3>();
+      d_children.torque = d_local.col(c).template tail<3>();
+      Eigen::Matrix<double, n, 1> d_tau;
+      Wrench<double> d_base_c;
+      tangent_backward_step<Segment>(kin, data.loads[k], data.wrench[k + 1], d_children, d_load[c],
+                                     rate, t[c], d_tau, d_base_c);
+      auto& out = c == 0 ? data.dtau_dq : data.dtau_dqdot;
+      out.template block<n, 1>(offset, i) = d_tau;
+      d_base.col(c) << d_base_c.force, d_base_c.torque;
+    }
+    // The coordinates before s: the wrench their segments transmit.
+    if (offset > 0)
+      store_coordinates_before(data, i, offset, force_to_world(base.R, base.p, d_base));
+  }
+}
+
+/// \brief The columns (q_i, qdot_i) of \f$\partial\tau\f$ for the NQ coordinates of any other
+/// segment s (the file comment): per coordinate, its calc, forward_step and backward_step in
+/// AutoDiff along (q_i, qdot_i).
+template <int NQ, class ChainT>
+void autodiff_segment_derivatives(const ChainT& chain, typename ChainT::Data& data, int s,
+                                  int s_offset) {
+  auto& ws = data.derivatives;
+  using AD = typename std::decay_t<decltype(ws)>::AD;
+  const InertiaRate rate = chain.inertia_rate;
+  const auto& frames = ws.frames;
+  const auto k = static_cast<std::size_t>(s);
+  const int s_end = s_offset + NQ;
+  const FrameInWorld& base = frames[k];
+  const FrameInWorld& distal = frames[k + 1];
+  const Eigen::Vector3d& w_d = data.motion[k + 1].omega;  // distal axes
+  const Eigen::Vector3d v_d = distal.R.transpose() * distal.v;
+  const Eigen::Vector3d v_b = base.R.transpose() * base.v;
+  for (int j = 0; j < NQ; ++j) {
+    const int i = s_offset + j;  // the block: directions (q_i, qdot_i)
+    ws.q(i).derivatives() << 1, 0;
+    ws.qdot(i).derivatives() << 0, 1;
+
+    // Segment s in AutoDiff: its kinematics and its forward step (its base does not move).
+    if (j == 0) segment_to_autodiff(chain, ws.chain, s);
+    // The distal frame's twist and spatial acceleration in its own axes, derived: (dv; dw)
+    // and (da - dw x v - w x dv; dalpha) (a spatial acceleration is a - w x v at the origin).
+    Eigen::Matrix<double, 6, kDerivativeBlock> dV, dA;
+    ws.chain.visit_segment(ws.data, s, [&](const auto& seg, auto& kin, int, int offset) {
+      constexpr int n = std::decay_t<decltype(seg)>::nq;
+      seg.calc(segment_entries<n>(ws.q, offset), segment_entries<n>(ws.qdot, offset), kin);
+      forward_step(seg, kin, autodiff_constant<AD>(data.motion[k]),
+                   segment_entries<n>(ws.qdot, offset), segment_entries<n>(ws.qddot, offset), true,
+                   rate, ws.data.motion[k + 1], ws.data.loads[k]);
+      Eigen::Matrix<AD, 3, 1> v = v_b.template cast<AD>();
+      v += data.motion[k].omega.template cast<AD>().cross(kin.r_base_distal);
+      if constexpr (n > 0)
+        v += kin.J_distal.template topRows<3>() * segment_entries<n>(ws.qdot, offset);
+      const Tangent3 dv =
+          derivatives_of(Eigen::Matrix<AD, 3, 1>(kin.R_base_distal.transpose() * v));
+      const Tangent3 dw = derivatives_of(ws.data.motion[k + 1].omega);
+      dV.template topRows<3>() = dv;
+      dV.template bottomRows<3>() = dw;
+      dA.template topRows<3>() = derivatives_of(ws.data.motion[k + 1].acc);
+      dA.template topRows<3>().noalias() += skew(v_d) * dw;
+      dA.template topRows<3>().noalias() -= skew(w_d) * dv;
+      dA.template bottomRows<3>() = derivatives_of(ws.data.motion[k + 1].alpha);
+    });
+    const Eigen::Matrix<double, 6, kDerivativeBlock> d_local =
+        distal_change_to_children(data, s, i, s_end, dV, dA);
+    // Segment s itself in AutoDiff, backward.
+    Eigen::Matrix<double, 6, kDerivativeBlock> d_base;
+    ws.chain.visit_segment(ws.data, s, [&](const auto& seg, const auto& kin, int, int) {
+      constexpr int n = std::decay_t<decltype(seg)>::nq;
+      Wrench<AD> children, base_wrench;
+      children.force =
+          with_derivatives<AD>(data.wrench[k + 1].force, d_local.template topRows<3>());
+      children.torque =
+          with_derivatives<AD>(data.wrench[k + 1].torque, d_local.template bottomRows<3>());
+      Eigen::Matrix<AD, n, 1> tau;
+      backward_step(seg, kin, ws.data.loads[k], children, rate, tau, base_wrench);
+      if constexpr (n > 0) {  // (s has coordinates; the others are never visited here)
+        for (int r = 0; r < n; ++r) {
+          data.dtau_dq(s_offset + r, i) = tau(r).derivatives()(0);
+          data.dtau_dqdot(s_offset + r, i) = tau(r).derivatives()(1);
+        }
+      }
+      d_base.template topRows<3>() = derivatives_of(base_wrench.force);
+      d_base.template bottomRows<3>() = derivatives_of(base_wrench.torque);
+    });
+    // The coordinates before s: the wrench their segments transmit.
+    if (s_offset > 0)
+      store_coordinates_before(data, i, s_offset, force_to_world(base.R, base.p, d_base));
+
+    ws.q(i).derivatives().setZero();
+    ws.qdot(i).derivatives().setZero();
+  }
+}
+
 /// \brief \f$\partial\tau/\partial q\f$ and \f$\partial\tau/\partial\dot q\f$ of the RNE at
 /// (q, qdot, qddot) into data.dtau_dq and data.dtau_dqdot (the file comment: one block
 /// (q_i, qdot_i) per coordinate, AutoDiff on the coordinate's own segment, the composites of
@@ -226,7 +417,6 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
   prepare_derivatives(chain, data);
   auto& ws = data.derivatives;
   using AD = typename std::decay_t<decltype(ws)>::AD;
-  const InertiaRate rate = chain.inertia_rate;
   const int nq = chain.num_coordinates(), n_seg = data.num_segments();
 
   // The expansion point, in double: what rnea() computes, kept in data.
@@ -239,101 +429,17 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
   }
 
   compute_derivative_composites(chain, data, qdot, with_mass_matrix ? &data.mass_matrix : nullptr);
-  const auto& frames = ws.frames;
-
-  for (int s = 0; s < n_seg; ++s) {
-    int s_offset = 0, s_nq = 0;
-    bool fixed_axis = false;
-    chain.visit_segment(data, s, [&](const auto& seg, const auto&, int, int offset) {
+  for (int s = 0; s < n_seg; ++s)
+    chain.visit_segment(data, s, [&](const auto& seg, const auto& kin, int, int offset) {
       using Segment = std::decay_t<decltype(seg)>;
-      s_offset = offset;
-      s_nq = Segment::nq;
-      fixed_axis = is_fixed_axis_joint<Segment>::value;
+      if constexpr (is_fixed_axis_joint<Segment>::value)
+        fixed_axis_derivatives(data, s, offset);
+      else if constexpr (has_tangent_steps<Segment, kDerivativeBlock>)
+        tangent_step_derivatives(chain, data, s, offset, seg, kin, qdot, qddot);
+      else if constexpr (Segment::nq > 0)
+        autodiff_segment_derivatives<Segment::nq>(chain, data, s, offset);
+      // (a segment without coordinates, a rigid link, has no columns)
     });
-    const auto k = static_cast<std::size_t>(s);
-    if (fixed_axis) {
-      fixed_axis_derivatives(data, s, s_offset);
-      continue;
-    }
-    const int s_end = s_offset + s_nq;
-    const FrameInWorld& base = frames[k];
-    const FrameInWorld& distal = frames[k + 1];
-    const Eigen::Vector3d& w_d = data.motion[k + 1].omega;  // distal axes
-    const Eigen::Vector3d v_d = distal.R.transpose() * distal.v;
-    const Eigen::Vector3d v_b = base.R.transpose() * base.v;
-    for (int j = 0; j < s_nq; ++j) {
-      const int i = s_offset + j;  // the block: directions (q_i, qdot_i)
-      ws.q(i).derivatives() << 1, 0;
-      ws.qdot(i).derivatives() << 0, 1;
-
-      // Segment s in AutoDiff: its kinematics and its forward step (its base does not move).
-      if (j == 0) segment_to_autodiff(chain, ws.chain, s);
-      // The distal frame's twist and spatial acceleration in its own axes, derived: (dv; dw)
-      // and (da - dw x v - w x dv; dalpha) (a spatial acceleration is a - w x v at the origin).
-      Eigen::Matrix<double, 6, kDerivativeBlock> dV, dA;
-      ws.chain.visit_segment(ws.data, s, [&](const auto& seg, auto& kin, int, int offset) {
-        constexpr int n = std::decay_t<decltype(seg)>::nq;
-        seg.calc(segment_entries<n>(ws.q, offset), segment_entries<n>(ws.qdot, offset), kin);
-        forward_step(seg, kin, autodiff_constant<AD>(data.motion[k]),
-                     segment_entries<n>(ws.qdot, offset), segment_entries<n>(ws.qddot, offset),
-                     true, rate, ws.data.motion[k + 1], ws.data.loads[k]);
-        Eigen::Matrix<AD, 3, 1> v = v_b.template cast<AD>();
-        v += data.motion[k].omega.template cast<AD>().cross(kin.r_base_distal);
-        if constexpr (n > 0)
-          v += kin.J_distal.template topRows<3>() * segment_entries<n>(ws.qdot, offset);
-        const Tangent3 dv =
-            derivatives_of(Eigen::Matrix<AD, 3, 1>(kin.R_base_distal.transpose() * v));
-        const Tangent3 dw = derivatives_of(ws.data.motion[k + 1].omega);
-        dV.template topRows<3>() = dv;
-        dV.template bottomRows<3>() = dw;
-        dA.template topRows<3>() = derivatives_of(ws.data.motion[k + 1].acc);
-        dA.template topRows<3>().noalias() += skew(v_d) * dw;
-        dA.template topRows<3>().noalias() -= skew(w_d) * dv;
-        dA.template bottomRows<3>() = derivatives_of(ws.data.motion[k + 1].alpha);
-      });
-      // In the world, and a~ = dA + V x dV (derivative_composites.hpp).
-      const Eigen::Matrix<double, 6, kDerivativeBlock> delta_V =
-          motion_to_world(distal.R, distal.p, dV);
-      Eigen::Matrix<double, 9, kDerivativeBlock> x;  // (a~; dV's angular part)
-      x.template topRows<6>() = motion_to_world(distal.R, distal.p, dA);
-      for (int c = 0; c < kDerivativeBlock; ++c)
-        x.template topRows<6>().col(c) += cross_motion(distal.twist, delta_V.col(c));
-      x.template bottomRows<3>() = delta_V.template bottomRows<3>();
-      store_coordinates_after(data, i, s_end, x);
-      // The wrench of everything after s, in s's distal axes about its origin.
-      const SubtreeComposite& beyond = ws.subtrees[k + 1];
-      const Eigen::Matrix<double, 6, kDerivativeBlock> d_children =
-          beyond.apply(x.template topRows<6>(), x.template bottomRows<3>());
-      const Eigen::Matrix<double, 6, kDerivativeBlock> d_local =
-          force_to_local(distal.R, distal.p, d_children);
-      // Segment s itself in AutoDiff, backward.
-      Eigen::Matrix<double, 6, kDerivativeBlock> d_base;
-      ws.chain.visit_segment(ws.data, s, [&](const auto& seg, const auto& kin, int, int) {
-        constexpr int n = std::decay_t<decltype(seg)>::nq;
-        Wrench<AD> children, base_wrench;
-        children.force =
-            with_derivatives<AD>(data.wrench[k + 1].force, d_local.template topRows<3>());
-        children.torque =
-            with_derivatives<AD>(data.wrench[k + 1].torque, d_local.template bottomRows<3>());
-        Eigen::Matrix<AD, n, 1> tau;
-        backward_step(seg, kin, ws.data.loads[k], children, rate, tau, base_wrench);
-        if constexpr (n > 0) {  // (s has coordinates; the others are never visited here)
-          for (int r = 0; r < n; ++r) {
-            data.dtau_dq(s_offset + r, i) = tau(r).derivatives()(0);
-            data.dtau_dqdot(s_offset + r, i) = tau(r).derivatives()(1);
-          }
-        }
-        d_base.template topRows<3>() = derivatives_of(base_wrench.force);
-        d_base.template bottomRows<3>() = derivatives_of(base_wrench.torque);
-      });
-      // The coordinates before s: the wrench their segments transmit.
-      if (s_offset > 0)
-        store_coordinates_before(data, i, s_offset, force_to_world(base.R, base.p, d_base));
-
-      ws.q(i).derivatives().setZero();
-      ws.qdot(i).derivatives().setZero();
-    }
-  }
 }
 
 }  // namespace detail
@@ -344,8 +450,9 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
 /// computeRNEADerivatives). Exact (this file's comment: AutoDiff on the perturbed segment
 /// only, world composites for the rest); cost one rnea(), one O(n) composite pass that also
 /// gives M (mass_matrix() agrees with it to rounding; the tests hold both to finite
-/// differences), and nq one-segment AutoDiff evaluations (none for a fixed-axis joint) with
-/// O(nq) short products each. Allocates nothing for a compile-time chain; a DynamicChain's
+/// differences), and per segment with coordinates one AutoDiff evaluation of a lumped CC
+/// joint's kinematics, or one of another segment's calc and steps per coordinate (none for a
+/// fixed-axis joint), with O(nq) short products per coordinate. Allocates nothing for a compile-time chain; a DynamicChain's
 /// Data sizes its derivative workspace at the first call.
 ///
 /// \tparam ChainT A Chain<...> or a DynamicChain<Scalar> of a floating-point Scalar.

@@ -1,0 +1,232 @@
+#pragma once
+/// \file
+/// \brief The derivative of one segment's RNE steps (rnea_steps.hpp's forward_step and
+/// backward_step) along one direction of its own coordinates or their rates, with its base's
+/// motion held: the tangent steps derivatives.hpp runs on the perturbed segment, in double,
+/// from the derivatives of the segment's kinematics (KinematicsTangent).
+///
+/// ## Where the kinematics' derivatives come from
+/// calc() runs once per segment in AutoDiff, seeded along its coordinates q_j only. Along a
+/// rate qdot_j nothing needs another evaluation: by the definitions of SegmentKinematics, calc's
+/// outputs depend on qdot only through \f$\dot J\dot q = (\sum_k \partial J/\partial q_k\,\dot
+/// q_k)\,\dot q\f$ (for J_distal and J_com) and \f$\dot I = \sum_k \partial I/\partial q_k\,\dot
+/// q_k\f$, so \f$\partial(\dot J\dot q)/\partial\dot q_j = \dot J e_j + (\partial J/\partial
+/// q_j)\dot q\f$ and \f$\partial\dot I/\partial\dot q_j = \partial I/\partial q_j\f$, both
+/// from the derivatives along q. (Until 2026-12-07 calc, forward_step and backward_step ran in
+/// AutoDiff once per coordinate, seeded along (q_j, qdot_j): 62k of the 100k instructions of
+/// rnea_derivatives on the paper's arm.)
+///
+/// ## The tangent steps
+/// The product rule on eqs. 11-18 as forward_step and backward_step write them (lumped body;
+/// the names below are theirs), base motion (w, dw, a_b) fixed, a prefix d for the derivative:
+/// - \f$d\omega = dJ_w\dot q + J_w d\dot q\f$, \f$d\alpha = dJ_w\ddot q + d(\dot J\dot q)_w +
+///   w\times d\omega\f$ (base axes); the distal frame's \f$d(R^T x) = dR^T x + R^T dx\f$;
+/// - \f$da_e = dw\times dr_e + dJ_v\ddot q + d(\dot J\dot q)_v + w\times(w\times dr_e) +
+///   2w\times(dJ_v\dot q + J_v d\dot q)\f$, likewise \f$da_c\f$ with r_c and J_com;
+/// - the load \f$f = m a_c\f$, \f$\tau^i = I\alpha^i + \omega^i\times I\omega^i + \dot
+///   I\omega^i\f$ (distal axes), turned to base axes by R;
+/// - backward: \f$\tau = J_v^T RF + J_w^T RN + J_c^T f + J_w^T\tau_b - \tfrac12\omega^{iT}
+///   \partial_k I\,\omega^i\f$ and the base wrench \f$(RF + f;\ RN + r_e\times RF + \tau_b +
+///   r_c\times f)\f$, differentiated term by term (\f$\partial_k I\f$ symmetric).
+/// The tests hold the derivatives that use these steps to central finite differences and to an
+/// AutoDiff pass of the whole RNE (tests/core/test_derivatives.cpp).
+
+#include <array>
+#include <cstddef>
+#include <type_traits>
+
+#include <Eigen/Core>
+
+#include "softrne/chain/motion.hpp"
+#include "softrne/segments/sub_bodies.hpp"
+#include "softrne/spatial/frame_placement.hpp"
+#include "softrne/spatial/skew.hpp"
+
+namespace softrne {
+namespace detail {
+
+/// \brief true for a segment whose perturbation derivatives.hpp takes through the tangent steps
+/// of this file: one lumped body (no sub-bodies), a rotation and a translation that both move,
+/// and at most as many coordinates as one AutoDiff evaluation carries (the CC joint with
+/// LumpedInertia). Other segments are evaluated in AutoDiff whole.
+template <class Segment, int MaxCoordinates>
+inline constexpr bool has_tangent_steps =
+    Segment::has_body && (num_sub_bodies<Segment> == 0) &&
+    !has_identity_rotation<Segment>::value && !has_zero_translation<Segment>::value &&
+    Segment::nq >= 1 && Segment::nq <= MaxCoordinates;
+
+/// \brief The derivative of a segment's kinematics (SegmentKinematics' fields, same names
+/// shortened) along one direction, and of its rates qdot along it.
+template <int NQ>
+struct KinematicsTangent {
+  using Matrix3 = Eigen::Matrix3d;
+  using Vector3 = Eigen::Vector3d;
+  Matrix3 R;                                                ///< of R_base_distal
+  Vector3 r_e;                                              ///< of r_base_distal
+  Vector3 r_c;                                              ///< of r_base_com
+  Eigen::Matrix<double, 6, NQ> J;                           ///< of J_distal
+  Eigen::Matrix<double, 6, 1> Jdq;                          ///< of Jdot_qdot_distal
+  Eigen::Matrix<double, 3, NQ> J_c;                         ///< of J_com
+  Vector3 Jdq_c;                                            ///< of Jdot_qdot_com
+  Matrix3 I;                                                ///< of inertia_com
+  Matrix3 I_rate;                                           ///< of inertia_rate
+  std::array<Matrix3, static_cast<std::size_t>(NQ)> dI_dq;  ///< of dinertia_dq
+  Eigen::Matrix<double, NQ, 1> qdot;                        ///< of qdot (e_j along qdot_j, else 0)
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/// \brief The derivatives of an AutoDiff matrix along direction c, as a double matrix.
+template <class M>
+Eigen::Matrix<double, M::RowsAtCompileTime, M::ColsAtCompileTime> derivative_along(const M& m,
+                                                                                   int c) {
+  Eigen::Matrix<double, M::RowsAtCompileTime, M::ColsAtCompileTime> out;
+  for (Eigen::Index j = 0; j < m.cols(); ++j)
+    for (Eigen::Index i = 0; i < m.rows(); ++i) out(i, j) = m(i, j).derivatives()(c);
+  return out;
+}
+
+/// \brief The kinematics' derivatives along q_j and along qdot_j (this file's comment).
+/// \param[in] ad The kinematics from calc() in AutoDiff, direction k of its derivatives along
+///   q_k (k < NQ), nothing along qdot.
+/// \param[in] kin The same kinematics in double (the expansion point).
+/// \param[in] qdot The segment's rates at the expansion point.
+/// \param[in] j The coordinate.
+template <int NQ, class KinAD, class Kin, class Qd>
+void kinematics_tangents(const KinAD& ad, const Kin& kin, const Eigen::MatrixBase<Qd>& qdot, int j,
+                         KinematicsTangent<NQ>& along_q, KinematicsTangent<NQ>& along_qdot) {
+  along_q.R = derivative_along(ad.R_base_distal, j);
+  along_q.r_e = derivative_along(ad.r_base_distal, j);
+  along_q.r_c = derivative_along(ad.r_base_com, j);
+  along_q.J = derivative_along(ad.J_distal, j);
+  along_q.Jdq = derivative_along(ad.Jdot_qdot_distal, j);
+  along_q.J_c = derivative_along(ad.J_com, j);
+  along_q.Jdq_c = derivative_along(ad.Jdot_qdot_com, j);
+  along_q.I = derivative_along(ad.inertia_com, j);
+  along_q.I_rate = derivative_along(ad.inertia_rate, j);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(NQ); ++k)
+    along_q.dI_dq[k] = derivative_along(ad.dinertia_dq[k], j);
+  along_q.qdot.setZero();
+
+  // Jdot e_j + (dJ/dq_j) qdot, with Jdot = sum_k (dJ/dq_k) qdot_k.
+  Eigen::Matrix<double, 6, 1> Jdot_j = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Vector3d Jdot_c_j = Eigen::Vector3d::Zero();
+  for (int k = 0; k < NQ; ++k) {
+    for (int r = 0; r < 6; ++r) Jdot_j(r) += ad.J_distal(r, j).derivatives()(k) * qdot(k);
+    for (int r = 0; r < 3; ++r) Jdot_c_j(r) += ad.J_com(r, j).derivatives()(k) * qdot(k);
+  }
+  along_qdot.R.setZero();
+  along_qdot.r_e.setZero();
+  along_qdot.r_c.setZero();
+  along_qdot.J.setZero();
+  along_qdot.Jdq.noalias() = Jdot_j + along_q.J * qdot;
+  along_qdot.J_c.setZero();
+  along_qdot.Jdq_c.noalias() = Jdot_c_j + along_q.J_c * qdot;
+  along_qdot.I.setZero();
+  along_qdot.I_rate = kin.dinertia_dq[static_cast<std::size_t>(j)];
+  for (auto& m : along_qdot.dI_dq) m.setZero();
+  along_qdot.qdot.setZero();
+  along_qdot.qdot(j) = 1;
+}
+
+/// \brief The derivative of forward_step (velocity terms on) along t: of the distal frame's
+/// motion and of the segment's load. distal and load are forward_step's outputs at the
+/// expansion point.
+template <class Segment, class Qd, class Qdd>
+void tangent_forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
+                          const FrameMotion<double>& base, const Eigen::MatrixBase<Qd>& qdot,
+                          const Eigen::MatrixBase<Qdd>& qddot, InertiaRate inertia_rate,
+                          const FrameMotion<double>& distal, const BodyLoad<double>& load,
+                          const KinematicsTangent<Segment::nq>& t, FrameMotion<double>& d_distal,
+                          BodyLoad<double>& d_load) {
+  static_assert(has_tangent_steps<Segment, Segment::nq>, "a lumped, moving segment only");
+  using Vector3 = Eigen::Vector3d;
+  const auto& R = kin.R_base_distal;
+  const auto Jv = kin.J_distal.template topRows<3>();
+  const auto Jw = kin.J_distal.template bottomRows<3>();
+  const auto dJv = t.J.template topRows<3>();
+  const auto dJw = t.J.template bottomRows<3>();
+  const Vector3& w = base.omega;
+  const Vector3& dw = base.alpha;
+
+  // Base axes: d omega, d alpha, d a_e, d a_c.
+  Vector3 d_omega = dJw * qdot;
+  d_omega.noalias() += Jw * t.qdot;
+  Vector3 d_alpha = dJw * qddot;
+  d_alpha += t.Jdq.template tail<3>() + cross3(w, d_omega);
+  Vector3 d_v_rel = dJv * qdot;
+  d_v_rel.noalias() += Jv * t.qdot;
+  Vector3 d_acc_e = cross3(dw, t.r_e) + cross3(w, cross3(w, t.r_e)) + 2.0 * cross3(w, d_v_rel);
+  d_acc_e.noalias() += dJv * qddot;
+  d_acc_e += t.Jdq.template head<3>();
+  Vector3 d_v_com = t.J_c * qdot;
+  d_v_com.noalias() += kin.J_com * t.qdot;
+  Vector3 d_acc_c = cross3(dw, t.r_c) + cross3(w, cross3(w, t.r_c)) + 2.0 * cross3(w, d_v_com);
+  d_acc_c.noalias() += t.J_c * qddot;
+  d_acc_c += t.Jdq_c;
+
+  // Into distal axes: d(R^T x) = dR^T x + R^T dx, with x = R x_distal.
+  const Vector3 omega = R * distal.omega, alpha = R * distal.alpha, acc_e = R * distal.acc;
+  d_distal.omega = transpose_times(t.R, omega) + transpose_times(R, d_omega);
+  d_distal.alpha = transpose_times(t.R, alpha) + transpose_times(R, d_alpha);
+  d_distal.acc = transpose_times(t.R, acc_e) + transpose_times(R, d_acc_e);
+
+  // The load: f = m a_c; tau^i = I alpha^i + omega^i x I omega^i (+ I-dot omega^i), base axes
+  // by R.
+  d_load.force = seg.mass * d_acc_c;
+  const auto& I = kin.inertia_com;
+  const Vector3& om = distal.omega;
+  const Vector3& d_om = d_distal.omega;
+  const Vector3 I_om = times(I, om);
+  const Vector3 d_I_om = times(t.I, om) + times(I, d_om);
+  Vector3 d_torque =
+      times(t.I, distal.alpha) + times(I, d_distal.alpha) + cross3(d_om, I_om) + cross3(om, d_I_om);
+  if (inertia_rate == InertiaRate::Consistent)
+    d_torque += times(t.I_rate, om) + times(kin.inertia_rate, d_om);
+  const Vector3 torque_distal = transpose_times(R, load.torque);
+  d_load.torque = times(t.R, torque_distal) + times(R, d_torque);
+  d_load.omega_distal = d_om;
+}
+
+/// \brief The derivative of backward_step along t: of the segment's generalised forces and of
+/// the wrench at its base (base axes, about the base origin).
+/// \param[in] children The children's wrench at the expansion point (distal axes, distal
+///   origin); \param[in] d_children its derivative.
+/// \param[in] load, d_load The load at the expansion point and its derivative
+///   (tangent_forward_step).
+template <class Segment>
+void tangent_backward_step(const typename Segment::Kinematics& kin, const BodyLoad<double>& load,
+                           const Wrench<double>& children, const Wrench<double>& d_children,
+                           const BodyLoad<double>& d_load, InertiaRate inertia_rate,
+                           const KinematicsTangent<Segment::nq>& t,
+                           Eigen::Matrix<double, Segment::nq, 1>& d_tau, Wrench<double>& d_base) {
+  static_assert(has_tangent_steps<Segment, Segment::nq>, "a lumped, moving segment only");
+  using Vector3 = Eigen::Vector3d;
+  constexpr int nq = Segment::nq;
+  const auto& R = kin.R_base_distal;
+  const Vector3 F = times(R, children.force), N = times(R, children.torque);
+  const Vector3 dF = times(t.R, children.force) + times(R, d_children.force);
+  const Vector3 dN = times(t.R, children.torque) + times(R, d_children.torque);
+  const auto Jv = kin.J_distal.template topRows<3>();
+  const auto Jw = kin.J_distal.template bottomRows<3>();
+  const Vector3 N_all = N + load.torque, dN_all = dN + d_load.torque;  // both through J_w
+  d_tau.noalias() = t.J.template topRows<3>().transpose() * F;
+  d_tau.noalias() += Jv.transpose() * dF;
+  d_tau.noalias() += t.J.template bottomRows<3>().transpose() * N_all;
+  d_tau.noalias() += Jw.transpose() * dN_all;
+  d_tau.noalias() += t.J_c.transpose() * load.force;
+  d_tau.noalias() += kin.J_com.transpose() * d_load.force;
+  if (inertia_rate == InertiaRate::Consistent) {
+    const Vector3& om = load.omega_distal;
+    const Vector3& d_om = d_load.omega_distal;
+    for (int k = 0; k < nq; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      d_tau(k) -= d_om.dot(times(kin.dinertia_dq[kk], om)) + 0.5 * om.dot(times(t.dI_dq[kk], om));
+    }
+  }
+  d_base.force = dF + d_load.force;
+  d_base.torque = dN + cross3(t.r_e, F) + cross3(kin.r_base_distal, dF) + d_load.torque +
+                  cross3(t.r_c, load.force) + cross3(kin.r_base_com, d_load.force);
+}
+
+}  // namespace detail
+}  // namespace softrne
