@@ -280,41 +280,53 @@ void tangent_step_derivatives(const ChainT& chain, typename ChainT::Data& data, 
   v.noalias() += kin.J_distal.template topRows<3>() * qd;
   const Eigen::Vector3d v_d = transpose_times(R, v);
   const Eigen::Vector3d& w_d = distal_motion.omega;
-  Wrench<double> d_children;
+  const TangentPoint<n> point =
+      tangent_point<Segment>(kin, distal_motion, data.loads[k], data.wrench[k + 1]);
   for (int j = 0; j < n; ++j) {
-    const int i = offset + j;  // the block: directions (q_i, qdot_i)
+    const int i = offset + j;  // the block: column 0 along q_i, column 1 along qdot_i
     KinematicsTangent<n> t[kDerivativeBlock];
     kinematics_tangents<n>(*kin_ad, kin, qd, j, t[0], t[1]);
     FrameMotion<double> d_distal[kDerivativeBlock];
     BodyLoad<double> d_load[kDerivativeBlock];
     Eigen::Matrix<double, 6, kDerivativeBlock> dV, dA;
-    for (int c = 0; c < kDerivativeBlock; ++c) {
-      tangent_forward_step(seg, kin, base_motion, qd, qdd, rate, distal_motion, data.loads[k], t[c],
-                           d_distal[c], d_load[c]);
-      // (dv; dw) and (da - dw x v - w x dv; dalpha), distal axes, as derivatives.hpp's
-      // AutoDiff path forms them.
-      Eigen::Vector3d dv_base = cross3(base_motion.omega, t[c].r_e);
-      dv_base.noalias() += t[c].J.template topRows<3>() * qd;
-      dv_base.noalias() += kin.J_distal.template topRows<3>() * t[c].qdot;
-      const Eigen::Vector3d dv = transpose_times(t[c].R, v) + transpose_times(R, dv_base);
+    auto forward = [&](auto along_rate) {
+      constexpr bool kRate = decltype(along_rate)::value;
+      constexpr int c = kRate ? 1 : 0;
+      tangent_forward_step<kRate>(seg, kin, base_motion, qd, qdd, rate, distal_motion, point, t[c],
+                                  d_distal[c], d_load[c]);
+      // (dv; dw) and (da - dw x v - w x dv; dalpha), distal axes, as the AutoDiff path
+      // (autodiff_segment_derivatives) forms them.
+      Eigen::Vector3d dv;
+      if constexpr (kRate) {
+        dv = transpose_times(R, kin.J_distal.template topRows<3>().col(j));
+      } else {
+        Eigen::Vector3d dv_base = cross3(base_motion.omega, t[c].r_e);
+        dv_base.noalias() += t[c].J.template topRows<3>() * qd;
+        dv = transpose_times(t[c].R, v) + transpose_times(R, dv_base);
+      }
       const Eigen::Vector3d& dw = d_distal[c].omega;
       dV.col(c) << dv, dw;
       dA.col(c) << d_distal[c].acc + cross3(v_d, dw) - cross3(w_d, dv), d_distal[c].alpha;
-    }
+    };
+    forward(std::false_type{});
+    forward(std::true_type{});
     const Eigen::Matrix<double, 6, kDerivativeBlock> d_local =
         distal_change_to_children(data, s, i, offset + n, dV, dA);
     Eigen::Matrix<double, 6, kDerivativeBlock> d_base;
-    for (int c = 0; c < kDerivativeBlock; ++c) {
+    auto backward = [&](auto along_rate) {
+      constexpr bool kRate = decltype(along_rate)::value;
+      constexpr int c = kRate ? 1 : 0;
+      Wrench<double> d_children, d_base_c;
       d_children.force = d_local.col(c).template head<3>();
       d_children.torque = d_local.col(c).template tail<3>();
       Eigen::Matrix<double, n, 1> d_tau;
-      Wrench<double> d_base_c;
-      tangent_backward_step<Segment>(kin, data.loads[k], data.wrench[k + 1], d_children, d_load[c],
-                                     rate, t[c], d_tau, d_base_c);
-      auto& out = c == 0 ? data.dtau_dq : data.dtau_dqdot;
-      out.template block<n, 1>(offset, i) = d_tau;
+      tangent_backward_step<kRate, Segment>(kin, data.loads[k], point, d_children, d_load[c], rate,
+                                            t[c], d_tau, d_base_c);
+      (kRate ? data.dtau_dqdot : data.dtau_dq).template block<n, 1>(offset, i) = d_tau;
       d_base.col(c) << d_base_c.force, d_base_c.torque;
-    }
+    };
+    backward(std::false_type{});
+    backward(std::true_type{});
     // The coordinates before s: the wrench their segments transmit.
     if (offset > 0)
       store_coordinates_before(data, i, offset, force_to_world(base.R, base.p, d_base));
@@ -452,8 +464,8 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
 /// gives M (mass_matrix() agrees with it to rounding; the tests hold both to finite
 /// differences), and per segment with coordinates one AutoDiff evaluation of a lumped CC
 /// joint's kinematics, or one of another segment's calc and steps per coordinate (none for a
-/// fixed-axis joint), with O(nq) short products per coordinate. Allocates nothing for a compile-time chain; a DynamicChain's
-/// Data sizes its derivative workspace at the first call.
+/// fixed-axis joint), with O(nq) short products per coordinate. Allocates nothing for a
+/// compile-time chain; a DynamicChain's Data sizes its derivative workspace at the first call.
 ///
 /// \tparam ChainT A Chain<...> or a DynamicChain<Scalar> of a floating-point Scalar.
 /// \param[in] chain The model.

@@ -56,7 +56,8 @@ inline constexpr bool has_tangent_steps =
     Segment::nq >= 1 && Segment::nq <= MaxCoordinates;
 
 /// \brief The derivative of a segment's kinematics (SegmentKinematics' fields, same names
-/// shortened) along one direction, and of its rates qdot along it.
+/// shortened) along one direction, and of its rates qdot along it. Along a rate qdot_j only
+/// Jdq, Jdq_c, I_rate and qdot are set (kinematics_tangents).
 template <int NQ>
 struct KinematicsTangent {
   using Matrix3 = Eigen::Matrix3d;
@@ -114,61 +115,102 @@ void kinematics_tangents(const KinAD& ad, const Kin& kin, const Eigen::MatrixBas
     for (int r = 0; r < 6; ++r) Jdot_j(r) += ad.J_distal(r, j).derivatives()(k) * qdot(k);
     for (int r = 0; r < 3; ++r) Jdot_c_j(r) += ad.J_com(r, j).derivatives()(k) * qdot(k);
   }
-  along_qdot.R.setZero();
-  along_qdot.r_e.setZero();
-  along_qdot.r_c.setZero();
-  along_qdot.J.setZero();
+  // Along qdot_j every other derivative is zero; the tangent steps do not read them.
   along_qdot.Jdq.noalias() = Jdot_j + along_q.J * qdot;
-  along_qdot.J_c.setZero();
   along_qdot.Jdq_c.noalias() = Jdot_c_j + along_q.J_c * qdot;
-  along_qdot.I.setZero();
   along_qdot.I_rate = kin.dinertia_dq[static_cast<std::size_t>(j)];
-  for (auto& m : along_qdot.dI_dq) m.setZero();
   along_qdot.qdot.setZero();
   along_qdot.qdot(j) = 1;
 }
 
+/// \brief What the tangent steps of one segment reuse from its expansion point, formed once
+/// per segment (tangent_point) for its 2 nq directions.
+template <int NQ>
+struct TangentPoint {
+  using Vector3 = Eigen::Vector3d;
+  Vector3 omega, alpha, acc_e;  ///< the distal frame's motion in base axes (R x^i)
+  Vector3 I_omega;              ///< I omega^i (distal axes)
+  Vector3 torque_distal;        ///< the load's torque in distal axes, R^T tau_b
+  Vector3 F_child, N_child;     ///< the children's wrench (distal axes, distal origin)
+  Vector3 F, N;                 ///< the same in base axes
+  Vector3 N_all;                ///< N + the load's torque (both reach q through J_w)
+  std::array<Vector3, static_cast<std::size_t>(NQ)> dI_omega;  ///< dI/dq_k omega^i
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/// \brief The TangentPoint of a segment from forward_step's outputs (distal, load) and the
+/// children's wrench at the expansion point (distal axes, distal origin).
+template <class Segment>
+TangentPoint<Segment::nq> tangent_point(const typename Segment::Kinematics& kin,
+                                        const FrameMotion<double>& distal,
+                                        const BodyLoad<double>& load,
+                                        const Wrench<double>& children) {
+  const auto& R = kin.R_base_distal;
+  TangentPoint<Segment::nq> p;
+  p.omega = times(R, distal.omega);
+  p.alpha = times(R, distal.alpha);
+  p.acc_e = times(R, distal.acc);
+  p.I_omega = times(kin.inertia_com, distal.omega);
+  p.torque_distal = transpose_times(R, load.torque);
+  p.F_child = children.force;
+  p.N_child = children.torque;
+  p.F = times(R, children.force);
+  p.N = times(R, children.torque);
+  p.N_all = p.N + load.torque;
+  for (std::size_t k = 0; k < p.dI_omega.size(); ++k)
+    p.dI_omega[k] = times(kin.dinertia_dq[k], load.omega_distal);
+  return p;
+}
+
 /// \brief The derivative of forward_step (velocity terms on) along t: of the distal frame's
-/// motion and of the segment's load. distal and load are forward_step's outputs at the
-/// expansion point.
-template <class Segment, class Qd, class Qdd>
+/// motion and of the segment's load; distal and load are forward_step's outputs at the
+/// expansion point, p their TangentPoint.
+/// \tparam AlongRate t is along a rate qdot_j: only t.Jdq, t.Jdq_c, t.I_rate and t.qdot are
+///   read (every other derivative of the kinematics is zero there).
+template <bool AlongRate, class Segment, class Qd, class Qdd>
 void tangent_forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
                           const FrameMotion<double>& base, const Eigen::MatrixBase<Qd>& qdot,
                           const Eigen::MatrixBase<Qdd>& qddot, InertiaRate inertia_rate,
-                          const FrameMotion<double>& distal, const BodyLoad<double>& load,
+                          const FrameMotion<double>& distal, const TangentPoint<Segment::nq>& p,
                           const KinematicsTangent<Segment::nq>& t, FrameMotion<double>& d_distal,
                           BodyLoad<double>& d_load) {
   static_assert(has_tangent_steps<Segment, Segment::nq>, "a lumped, moving segment only");
   using Vector3 = Eigen::Vector3d;
   const auto& R = kin.R_base_distal;
-  const auto Jv = kin.J_distal.template topRows<3>();
-  const auto Jw = kin.J_distal.template bottomRows<3>();
-  const auto dJv = t.J.template topRows<3>();
-  const auto dJw = t.J.template bottomRows<3>();
   const Vector3& w = base.omega;
   const Vector3& dw = base.alpha;
 
   // Base axes: d omega, d alpha, d a_e, d a_c.
-  Vector3 d_omega = dJw * qdot;
-  d_omega.noalias() += Jw * t.qdot;
-  Vector3 d_alpha = dJw * qddot;
-  d_alpha += t.Jdq.template tail<3>() + cross3(w, d_omega);
-  Vector3 d_v_rel = dJv * qdot;
-  d_v_rel.noalias() += Jv * t.qdot;
-  Vector3 d_acc_e = cross3(dw, t.r_e) + cross3(w, cross3(w, t.r_e)) + 2.0 * cross3(w, d_v_rel);
-  d_acc_e.noalias() += dJv * qddot;
-  d_acc_e += t.Jdq.template head<3>();
-  Vector3 d_v_com = t.J_c * qdot;
-  d_v_com.noalias() += kin.J_com * t.qdot;
-  Vector3 d_acc_c = cross3(dw, t.r_c) + cross3(w, cross3(w, t.r_c)) + 2.0 * cross3(w, d_v_com);
-  d_acc_c.noalias() += t.J_c * qddot;
-  d_acc_c += t.Jdq_c;
+  Vector3 d_omega, d_v_rel, d_v_com;
+  if constexpr (AlongRate) {
+    d_omega.noalias() = kin.J_distal.template bottomRows<3>() * t.qdot;
+    d_v_rel.noalias() = kin.J_distal.template topRows<3>() * t.qdot;
+    d_v_com.noalias() = kin.J_com * t.qdot;
+  } else {
+    d_omega.noalias() = t.J.template bottomRows<3>() * qdot;
+    d_v_rel.noalias() = t.J.template topRows<3>() * qdot;
+    d_v_com.noalias() = t.J_c * qdot;
+  }
+  Vector3 d_alpha = t.Jdq.template tail<3>() + cross3(w, d_omega);
+  Vector3 d_acc_e = t.Jdq.template head<3>() + 2.0 * cross3(w, d_v_rel);
+  Vector3 d_acc_c = t.Jdq_c + 2.0 * cross3(w, d_v_com);
+  if constexpr (!AlongRate) {
+    d_alpha.noalias() += t.J.template bottomRows<3>() * qddot;
+    d_acc_e += cross3(dw, t.r_e) + cross3(w, cross3(w, t.r_e));
+    d_acc_e.noalias() += t.J.template topRows<3>() * qddot;
+    d_acc_c += cross3(dw, t.r_c) + cross3(w, cross3(w, t.r_c));
+    d_acc_c.noalias() += t.J_c * qddot;
+  }
 
-  // Into distal axes: d(R^T x) = dR^T x + R^T dx, with x = R x_distal.
-  const Vector3 omega = R * distal.omega, alpha = R * distal.alpha, acc_e = R * distal.acc;
-  d_distal.omega = transpose_times(t.R, omega) + transpose_times(R, d_omega);
-  d_distal.alpha = transpose_times(t.R, alpha) + transpose_times(R, d_alpha);
-  d_distal.acc = transpose_times(t.R, acc_e) + transpose_times(R, d_acc_e);
+  // Into distal axes: d(R^T x) = dR^T x + R^T dx.
+  d_distal.omega = transpose_times(R, d_omega);
+  d_distal.alpha = transpose_times(R, d_alpha);
+  d_distal.acc = transpose_times(R, d_acc_e);
+  if constexpr (!AlongRate) {
+    d_distal.omega += transpose_times(t.R, p.omega);
+    d_distal.alpha += transpose_times(t.R, p.alpha);
+    d_distal.acc += transpose_times(t.R, p.acc_e);
+  }
 
   // The load: f = m a_c; tau^i = I alpha^i + omega^i x I omega^i (+ I-dot omega^i), base axes
   // by R.
@@ -176,26 +218,27 @@ void tangent_forward_step(const Segment& seg, const typename Segment::Kinematics
   const auto& I = kin.inertia_com;
   const Vector3& om = distal.omega;
   const Vector3& d_om = d_distal.omega;
-  const Vector3 I_om = times(I, om);
-  const Vector3 d_I_om = times(t.I, om) + times(I, d_om);
-  Vector3 d_torque =
-      times(t.I, distal.alpha) + times(I, d_distal.alpha) + cross3(d_om, I_om) + cross3(om, d_I_om);
+  Vector3 d_I_om = times(I, d_om);
+  if constexpr (!AlongRate) d_I_om += times(t.I, om);
+  Vector3 d_torque = times(I, d_distal.alpha) + cross3(d_om, p.I_omega) + cross3(om, d_I_om);
+  if constexpr (!AlongRate) d_torque += times(t.I, distal.alpha);
   if (inertia_rate == InertiaRate::Consistent)
     d_torque += times(t.I_rate, om) + times(kin.inertia_rate, d_om);
-  const Vector3 torque_distal = transpose_times(R, load.torque);
-  d_load.torque = times(t.R, torque_distal) + times(R, d_torque);
+  d_load.torque = times(R, d_torque);
+  if constexpr (!AlongRate) d_load.torque += times(t.R, p.torque_distal);
   d_load.omega_distal = d_om;
 }
 
 /// \brief The derivative of backward_step along t: of the segment's generalised forces and of
 /// the wrench at its base (base axes, about the base origin).
-/// \param[in] children The children's wrench at the expansion point (distal axes, distal
-///   origin); \param[in] d_children its derivative.
-/// \param[in] load, d_load The load at the expansion point and its derivative
-///   (tangent_forward_step).
-template <class Segment>
+/// \param[in] load The load at the expansion point; \param[in] p its TangentPoint (with the
+///   children's wrench).
+/// \param[in] d_children The derivative of the children's wrench (distal axes, distal origin).
+/// \param[in] d_load The load's derivative (tangent_forward_step).
+/// \tparam AlongRate As for tangent_forward_step.
+template <bool AlongRate, class Segment>
 void tangent_backward_step(const typename Segment::Kinematics& kin, const BodyLoad<double>& load,
-                           const Wrench<double>& children, const Wrench<double>& d_children,
+                           const TangentPoint<Segment::nq>& p, const Wrench<double>& d_children,
                            const BodyLoad<double>& d_load, InertiaRate inertia_rate,
                            const KinematicsTangent<Segment::nq>& t,
                            Eigen::Matrix<double, Segment::nq, 1>& d_tau, Wrench<double>& d_base) {
@@ -203,29 +246,34 @@ void tangent_backward_step(const typename Segment::Kinematics& kin, const BodyLo
   using Vector3 = Eigen::Vector3d;
   constexpr int nq = Segment::nq;
   const auto& R = kin.R_base_distal;
-  const Vector3 F = times(R, children.force), N = times(R, children.torque);
-  const Vector3 dF = times(t.R, children.force) + times(R, d_children.force);
-  const Vector3 dN = times(t.R, children.torque) + times(R, d_children.torque);
-  const auto Jv = kin.J_distal.template topRows<3>();
-  const auto Jw = kin.J_distal.template bottomRows<3>();
-  const Vector3 N_all = N + load.torque, dN_all = dN + d_load.torque;  // both through J_w
-  d_tau.noalias() = t.J.template topRows<3>().transpose() * F;
-  d_tau.noalias() += Jv.transpose() * dF;
-  d_tau.noalias() += t.J.template bottomRows<3>().transpose() * N_all;
-  d_tau.noalias() += Jw.transpose() * dN_all;
-  d_tau.noalias() += t.J_c.transpose() * load.force;
+  Vector3 dF = times(R, d_children.force);
+  Vector3 dN = times(R, d_children.torque);
+  if constexpr (!AlongRate) {
+    dF += times(t.R, p.F_child);
+    dN += times(t.R, p.N_child);
+  }
+  const Vector3 dN_all = dN + d_load.torque;  // both through J_w
+  d_tau.noalias() = kin.J_distal.template topRows<3>().transpose() * dF;
+  d_tau.noalias() += kin.J_distal.template bottomRows<3>().transpose() * dN_all;
   d_tau.noalias() += kin.J_com.transpose() * d_load.force;
+  if constexpr (!AlongRate) {
+    d_tau.noalias() += t.J.template topRows<3>().transpose() * p.F;
+    d_tau.noalias() += t.J.template bottomRows<3>().transpose() * p.N_all;
+    d_tau.noalias() += t.J_c.transpose() * load.force;
+  }
   if (inertia_rate == InertiaRate::Consistent) {
     const Vector3& om = load.omega_distal;
     const Vector3& d_om = d_load.omega_distal;
     for (int k = 0; k < nq; ++k) {
       const auto kk = static_cast<std::size_t>(k);
-      d_tau(k) -= d_om.dot(times(kin.dinertia_dq[kk], om)) + 0.5 * om.dot(times(t.dI_dq[kk], om));
+      d_tau(k) -= d_om.dot(p.dI_omega[kk]);
+      if constexpr (!AlongRate) d_tau(k) -= 0.5 * om.dot(times(t.dI_dq[kk], om));
     }
   }
   d_base.force = dF + d_load.force;
-  d_base.torque = dN + cross3(t.r_e, F) + cross3(kin.r_base_distal, dF) + d_load.torque +
-                  cross3(t.r_c, load.force) + cross3(kin.r_base_com, d_load.force);
+  d_base.torque =
+      dN + cross3(kin.r_base_distal, dF) + d_load.torque + cross3(kin.r_base_com, d_load.force);
+  if constexpr (!AlongRate) d_base.torque += cross3(t.r_e, p.F) + cross3(t.r_c, load.force);
 }
 
 }  // namespace detail
