@@ -20,18 +20,21 @@
 ///   Pinocchio's computeRNEADerivatives) each such row costs one 9-vector product;
 /// - **the coordinates before s** see only the wrench s passes back: one 6-vector product each
 ///   with their world Jacobian; and s's own rows take the children's wrench from the
-///   subtree's composite inertias (derivative_composites.hpp) into its AutoDiff backward step.
+///   subtree's composite inertias (derivative_composites.hpp) into its backward step (its
+///   tangent, or the step in AutoDiff).
 /// So nq blocks cost one AutoDiff evaluation of calc per lumped CC joint (of calc and both
 /// steps per coordinate for other segments) plus O(nq) short products each.
 /// Until 2026-12-07 the rest of the chain was walked segment by segment in local axes for
 /// every block (3 x 2 tangent steps, O(n) each, 2.2-8x Pinocchio); docs/performance.md has
 /// both. Exact to rounding (no step size), at phi = 0 and across the series switches, for
 /// every segment type: a new one is differentiated as soon as it has calc (the composites read
-/// only the fields every segment's kinematics have). Analytical recursions for the CC joint
-/// itself would also remove the AutoDiff on segment s: they need the second derivatives of a
-/// CC joint's pose, Jacobians and inertia (\f$\partial J/\partial q\f$,
+/// only the fields every segment's kinematics have). The CC joint's calc in AutoDiff is what
+/// is left of AutoDiff on the lumped arm (a third of rnea_derivatives' instructions on the
+/// paper's arm, docs/performance.md): written out, it needs the second derivatives of a CC
+/// joint's pose, Jacobians and inertia (\f$\partial J/\partial q\f$,
 /// \f$\partial\dot J\dot q/\partial q\f$, \f$\partial^2 I/\partial q^2\f$, per quadrature disk
-/// for a distributed joint) and their series below the switch, derived and tested anew.
+/// for a distributed joint) and their series below the switch, derived and tested anew; they
+/// would replace the input of segment_tangent.hpp's kinematics_tangents.
 ///
 /// ## Forward dynamics
 /// From \f$M(q)\ddot q = \tau - b(q,\dot q)\f$ with \f$\mathrm{ID}(q,\dot q,\ddot q) = M\ddot q +
