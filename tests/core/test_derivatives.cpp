@@ -9,7 +9,9 @@
 // on random states, at phi = 0 exactly and on both sides of the CC functions' series
 // switches (cc_functions.hpp); both chain kinds (a compile-time chain against the same
 // runtime chain); the size errors of a runtime chain; no heap allocation (static chain, and a
-// runtime chain after its first call), with the guard's positive control.
+// runtime chain after its first call), with the guard's positive control. And the one claim of
+// segment_tangent.hpp the RNE tests see only through the whole: the rate directions derived
+// from calc seeded along q equal calc seeded along the rates.
 #include "../eigen_malloc_guard.hpp"  // first: before anything includes Eigen
 #include <gtest/gtest.h>
 
@@ -240,6 +242,79 @@ TEST(AbaDerivatives, RandomHybridChainsAndStates) {
 
 TEST(AbaDerivatives, AtZeroBendingAndAtTheSeriesSwitches) {
   on_special_states(24, "aba_derivatives, phi = 0 and series switches", check_aba);
+}
+
+// ---------------------------------------------------------------------------------------
+// The tangent steps' kinematics (segment_tangent.hpp): the directions along qdot_j are derived
+// from calc in AutoDiff seeded along q only. Here calc is seeded along (q_j, qdot_j) instead,
+// its derivatives along qdot_j read directly, and the along-q ones compared too.
+
+TEST(KinematicsTangents, RateDirectionsEqualCalcSeededAlongTheRates) {
+  using AD = DerivativeScalar<double>;
+  using CCAD = ConstantCurvatureJoint<AD>;
+  // Relative to the reference's size (these are 1e-3 to 10; the floor only guards zeros).
+  auto rel = [](const MatrixXd& a, const MatrixXd& b) {
+    return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-8);
+  };
+  std::mt19937 rng(26);
+  double worst = 0;
+  // Random bendings, phi = 0 exactly, and both sides of the series switches (phi^2 = 0.25, 1).
+  std::vector<Eigen::Vector2d> qs;
+  for (int r = 0; r < 20; ++r) qs.push_back(random_vector(rng, 2, 1.5));
+  qs.push_back(Eigen::Vector2d::Zero());
+  for (double x : {0.25, 1.0})
+    for (double f : {1 - 1e-9, 1 + 1e-9})
+      qs.push_back(Eigen::Vector2d(0.6, 0.8) * std::sqrt(x * f));
+  for (const Eigen::Vector2d& q : qs) {
+    const CC cc = random_cc(rng);
+    const CCAD cc_ad = cc.cast<AD>();
+    const Eigen::Vector2d qd = random_vector(rng, 2, 2.0);
+    CC::Kinematics kin;
+    cc.calc(q, qd, kin);
+    // As derivatives.hpp seeds it: direction k along q_k.
+    Eigen::Matrix<AD, 2, 1> q_ad, qd_ad;
+    for (int k = 0; k < 2; ++k) {
+      q_ad(k) = AD(q(k), Eigen::Vector2d::Unit(k));
+      qd_ad(k) = AD(qd(k), Eigen::Vector2d::Zero());
+    }
+    CCAD::Kinematics kin_q;
+    cc_ad.calc(q_ad, qd_ad, kin_q);
+    for (int j = 0; j < 2; ++j) {
+      detail::KinematicsTangent<2> along_q, along_qdot;
+      detail::kinematics_tangents<2>(kin_q, kin, qd, j, along_q, along_qdot);
+      // The reference: direction 0 along q_j, direction 1 along qdot_j.
+      Eigen::Matrix<AD, 2, 1> q_j, qd_j;
+      for (int k = 0; k < 2; ++k) {
+        q_j(k) = AD(q(k), Eigen::Vector2d::Zero());
+        qd_j(k) = AD(qd(k), Eigen::Vector2d::Zero());
+      }
+      q_j(j).derivatives()(0) = 1;
+      qd_j(j).derivatives()(1) = 1;
+      CCAD::Kinematics ref;
+      cc_ad.calc(q_j, qd_j, ref);
+      using detail::derivative_along;
+      const double e = std::max(
+          {rel(along_qdot.Jdq, derivative_along(ref.Jdot_qdot_distal, 1)),
+           rel(along_qdot.Jdq_c, derivative_along(ref.Jdot_qdot_com, 1)),
+           rel(along_qdot.I_rate, derivative_along(ref.inertia_rate, 1)),
+           rel(along_q.Jdq, derivative_along(ref.Jdot_qdot_distal, 0)),
+           rel(along_q.I_rate, derivative_along(ref.inertia_rate, 0)),
+           rel(along_q.R, derivative_along(ref.R_base_distal, 0)),
+           rel(along_q.J, derivative_along(ref.J_distal, 0)),
+           rel(along_q.dI_dq[1], derivative_along(ref.dinertia_dq[1], 0))});
+      EXPECT_LT(e, 1e-13) << "q " << q.transpose() << " qdot " << qd.transpose() << " j " << j;
+      worst = std::max(worst, e);
+      // Nothing else of calc depends on qdot (the claim the derivation rests on).
+      EXPECT_EQ(derivative_along(ref.R_base_distal, 1).norm(), 0.0);
+      EXPECT_EQ(derivative_along(ref.J_distal, 1).norm(), 0.0);
+      EXPECT_EQ(derivative_along(ref.J_com, 1).norm(), 0.0);
+      EXPECT_EQ(derivative_along(ref.r_base_com, 1).norm(), 0.0);
+      EXPECT_EQ(derivative_along(ref.inertia_com, 1).norm(), 0.0);
+      EXPECT_EQ(derivative_along(ref.dinertia_dq[0], 1).norm(), 0.0);
+    }
+  }
+  std::printf("[ info ] kinematics_tangents against calc seeded along the rates: worst relative "
+              "error %.1e\n", worst);
 }
 
 // ---------------------------------------------------------------------------------------
