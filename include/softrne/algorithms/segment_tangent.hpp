@@ -56,8 +56,8 @@ inline constexpr bool has_tangent_steps =
     Segment::nq >= 1 && Segment::nq <= MaxCoordinates;
 
 /// \brief The derivative of a segment's kinematics (SegmentKinematics' fields, same names
-/// shortened) along one direction, and of its rates qdot along it. Along a rate qdot_j only
-/// Jdq, Jdq_c, I_rate and qdot are set (kinematics_tangents).
+/// shortened) along one direction: a coordinate q_j, or a rate qdot_j (`rate` = j). Along a
+/// rate only Jdq, Jdq_c, I_rate and rate are set (kinematics_tangents).
 template <int NQ>
 struct KinematicsTangent {
   using Matrix3 = Eigen::Matrix3d;
@@ -72,7 +72,7 @@ struct KinematicsTangent {
   Matrix3 I;                                                ///< of inertia_com
   Matrix3 I_rate;                                           ///< of inertia_rate
   std::array<Matrix3, static_cast<std::size_t>(NQ)> dI_dq;  ///< of dinertia_dq
-  Eigen::Matrix<double, NQ, 1> qdot;                        ///< of qdot (e_j along qdot_j, else 0)
+  int rate = -1;  ///< j along qdot_j (qdot's derivative is e_j there), -1 along a coordinate
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
@@ -106,7 +106,6 @@ void kinematics_tangents(const KinAD& ad, const Kin& kin, const Eigen::MatrixBas
   along_q.I_rate = derivative_along(ad.inertia_rate, j);
   for (std::size_t k = 0; k < static_cast<std::size_t>(NQ); ++k)
     along_q.dI_dq[k] = derivative_along(ad.dinertia_dq[k], j);
-  along_q.qdot.setZero();
 
   // Jdot e_j + (dJ/dq_j) qdot, with Jdot = sum_k (dJ/dq_k) qdot_k.
   Eigen::Matrix<double, 6, 1> Jdot_j = Eigen::Matrix<double, 6, 1>::Zero();
@@ -119,8 +118,7 @@ void kinematics_tangents(const KinAD& ad, const Kin& kin, const Eigen::MatrixBas
   along_qdot.Jdq.noalias() = Jdot_j + along_q.J * qdot;
   along_qdot.Jdq_c.noalias() = Jdot_c_j + along_q.J_c * qdot;
   along_qdot.I_rate = kin.dinertia_dq[static_cast<std::size_t>(j)];
-  along_qdot.qdot.setZero();
-  along_qdot.qdot(j) = 1;
+  along_qdot.rate = j;
 }
 
 /// \brief What the tangent steps of one segment reuse from its expansion point, formed once
@@ -165,7 +163,7 @@ TangentPoint<Segment::nq> tangent_point(const typename Segment::Kinematics& kin,
 /// \brief The derivative of forward_step (velocity terms on) along t: of the distal frame's
 /// motion and of the segment's load; distal and load are forward_step's outputs at the
 /// expansion point, p their TangentPoint.
-/// \tparam AlongRate t is along a rate qdot_j: only t.Jdq, t.Jdq_c, t.I_rate and t.qdot are
+/// \tparam AlongRate t is along a rate qdot_j: only t.Jdq, t.Jdq_c, t.I_rate and t.rate are
 ///   read (every other derivative of the kinematics is zero there).
 template <bool AlongRate, class Segment, class Qd, class Qdd>
 void tangent_forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
@@ -183,9 +181,9 @@ void tangent_forward_step(const Segment& seg, const typename Segment::Kinematics
   // Base axes: d omega, d alpha, d a_e, d a_c.
   Vector3 d_omega, d_v_rel, d_v_com;
   if constexpr (AlongRate) {
-    d_omega.noalias() = kin.J_distal.template bottomRows<3>() * t.qdot;
-    d_v_rel.noalias() = kin.J_distal.template topRows<3>() * t.qdot;
-    d_v_com.noalias() = kin.J_com * t.qdot;
+    d_omega = kin.J_distal.template bottomRows<3>().col(t.rate);
+    d_v_rel = kin.J_distal.template topRows<3>().col(t.rate);
+    d_v_com = kin.J_com.col(t.rate);
   } else {
     d_omega.noalias() = t.J.template bottomRows<3>() * qdot;
     d_v_rel.noalias() = t.J.template topRows<3>() * qdot;
