@@ -246,8 +246,10 @@ TEST(AbaDerivatives, AtZeroBendingAndAtTheSeriesSwitches) {
 
 // ---------------------------------------------------------------------------------------
 // The tangent steps' kinematics (segment_tangent.hpp): the directions along qdot_j are derived
-// from calc in AutoDiff seeded along q only. Here calc is seeded along (q_j, qdot_j) instead,
-// its derivatives along qdot_j read directly, and the along-q ones compared too.
+// from calc_motion in AutoDiff seeded along q only, the inertia's from calc in double and the
+// CC joint's inertia_hessian_times. Here the whole calc is seeded along (q_j, qdot_j) instead,
+// its derivatives along qdot_j read directly, and the along-q ones compared too (the inertia's
+// second derivatives among them, against AutoDiff of calc's first ones).
 
 TEST(KinematicsTangents, RateDirectionsEqualCalcSeededAlongTheRates) {
   using AD = DerivativeScalar<double>;
@@ -278,10 +280,15 @@ TEST(KinematicsTangents, RateDirectionsEqualCalcSeededAlongTheRates) {
       qd_ad(k) = AD(qd(k), Eigen::Vector2d::Zero());
     }
     CCAD::Kinematics kin_q;
-    cc_ad.calc(q_ad, qd_ad, kin_q);
+    cc_ad.calc_motion(q_ad, qd_ad, kin_q);
+    // The vector the inertia's derivatives are applied to (the distal angular velocity there).
+    const Eigen::Vector3d w = random_vector(rng, 3, 2.0);
+    detail::InertiaHessianTimes<2> hessian_w;
+    cc.inertia_hessian_times(q, kin, w, hessian_w);
+    const std::array<Eigen::Vector3d, 2> dI_w = {kin.dinertia_dq[0] * w, kin.dinertia_dq[1] * w};
     for (int j = 0; j < 2; ++j) {
       detail::KinematicsTangent<2> along_q, along_qdot;
-      detail::kinematics_tangents<2>(kin_q, kin, qd, j, along_q, along_qdot);
+      detail::kinematics_tangents<2>(kin_q, kin, &hessian_w, dI_w, qd, j, along_q, along_qdot);
       // The reference: direction 0 along q_j, direction 1 along qdot_j.
       Eigen::Matrix<AD, 2, 1> q_j, qd_j;
       for (int k = 0; k < 2; ++k) {
@@ -296,13 +303,17 @@ TEST(KinematicsTangents, RateDirectionsEqualCalcSeededAlongTheRates) {
       const double e = std::max(
           {rel(along_qdot.Jdq, derivative_along(ref.Jdot_qdot_distal, 1)),
            rel(along_qdot.Jdq_c, derivative_along(ref.Jdot_qdot_com, 1)),
-           rel(along_qdot.I_rate, derivative_along(ref.inertia_rate, 1)),
+           rel(along_qdot.I_rate_omega, derivative_along(ref.inertia_rate, 1) * w),
            rel(along_q.Jdq, derivative_along(ref.Jdot_qdot_distal, 0)),
-           rel(along_q.I_rate, derivative_along(ref.inertia_rate, 0)),
+           rel(along_q.Jdq_c, derivative_along(ref.Jdot_qdot_com, 0)),
            rel(along_q.R, derivative_along(ref.R_base_distal, 0)),
            rel(along_q.J, derivative_along(ref.J_distal, 0)),
-           rel(along_q.dI_dq[1], derivative_along(ref.dinertia_dq[1], 0))});
-      EXPECT_LT(e, 1e-13) << "q " << q.transpose() << " qdot " << qd.transpose() << " j " << j;
+           rel(along_q.J_c, derivative_along(ref.J_com, 0)),
+           rel(along_q.I, derivative_along(ref.inertia_com, 0)),
+           rel(along_q.I_rate_omega, derivative_along(ref.inertia_rate, 0) * w),
+           rel(along_q.dI_dq_omega[0], derivative_along(ref.dinertia_dq[0], 0) * w),
+           rel(along_q.dI_dq_omega[1], derivative_along(ref.dinertia_dq[1], 0) * w)});
+      EXPECT_LT(e, 5e-12) << "q " << q.transpose() << " qdot " << qd.transpose() << " j " << j;
       worst = std::max(worst, e);
       // Nothing else of calc depends on qdot (the claim the derivation rests on).
       EXPECT_EQ(derivative_along(ref.R_base_distal, 1).norm(), 0.0);

@@ -22,19 +22,20 @@
 ///   with their world Jacobian; and s's own rows take the children's wrench from the
 ///   subtree's composite inertias (derivative_composites.hpp) into its backward step (its
 ///   tangent, or the step in AutoDiff).
-/// So nq blocks cost one AutoDiff evaluation of calc per lumped CC joint (of calc and both
-/// steps per coordinate for other segments) plus O(nq) short products each.
+/// So nq blocks cost one AutoDiff evaluation of calc_motion per lumped CC joint (of calc and
+/// both steps per coordinate for other segments) plus O(nq) short products each.
 /// Until 2026-12-07 the rest of the chain was walked segment by segment in local axes for
 /// every block (3 x 2 tangent steps, O(n) each, 2.2-8x Pinocchio); docs/performance.md has
 /// both. Exact to rounding (no step size), at phi = 0 and across the series switches, for
 /// every segment type: a new one is differentiated as soon as it has calc (the composites read
-/// only the fields every segment's kinematics have). The CC joint's calc in AutoDiff is what
-/// is left of AutoDiff on the lumped arm (a third of rnea_derivatives' instructions on the
-/// paper's arm, docs/performance.md): written out, it needs the second derivatives of a CC
-/// joint's pose, Jacobians and inertia (\f$\partial J/\partial q\f$,
-/// \f$\partial\dot J\dot q/\partial q\f$, \f$\partial^2 I/\partial q^2\f$, per quadrature disk
-/// for a distributed joint) and their series below the switch, derived and tested anew; they
-/// would replace the input of segment_tangent.hpp's kinematics_tangents.
+/// only the fields every segment's kinematics have). The lumped CC joint's inertia has its
+/// second derivatives written out (ConstantCurvatureJoint::inertia_hessian_times, since
+/// 2026-12-07, in place of calc_inertia in AutoDiff: 9 % fewer instructions for the whole of
+/// rnea_derivatives on the paper's arm); its calc_motion in AutoDiff (pose, Jacobians and
+/// their rates) is what is left of AutoDiff on the lumped arm (a tenth of rnea_derivatives'
+/// instructions there, docs/performance.md). Written out, it would need \f$\partial
+/// J/\partial q\f$ and \f$\partial\dot J\dot q/\partial q\f$ (third derivatives of the g_k)
+/// with their series below the switch.
 ///
 /// ## Forward dynamics
 /// From \f$M(q)\ddot q = \tau - b(q,\dot q)\f$ with \f$\mathrm{ID}(q,\dot q,\ddot q) = M\ddot q +
@@ -244,13 +245,14 @@ Eigen::Matrix<double, 6, kDerivativeBlock> distal_change_to_children(
 }
 
 /// \brief The columns (q_i, qdot_i) of \f$\partial\tau\f$ for the coordinates of a segment s
-/// with tangent steps (segment_tangent.hpp: a lumped CC joint): its calc() once in AutoDiff
-/// along its coordinates, then per coordinate the tangent steps in double, the rows after s and
-/// before s as for any segment (the file comment).
-template <class ChainT, class Segment, class Qd, class Qdd>
+/// with tangent steps (segment_tangent.hpp: a lumped CC joint): its calc_motion() once in
+/// AutoDiff along its coordinates and its inertia_hessian_times() in double, then per
+/// coordinate the tangent steps in double, the rows after s and before s as for any segment
+/// (the file comment).
+template <class ChainT, class Segment, class Q, class Qd, class Qdd>
 void tangent_step_derivatives(const ChainT& chain, typename ChainT::Data& data, int s, int offset,
                               const Segment& seg, const typename Segment::Kinematics& kin,
-                              const Eigen::MatrixBase<Qd>& qdot,
+                              const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
                               const Eigen::MatrixBase<Qdd>& qddot) {
   static_assert(has_tangent_steps<Segment, kDerivativeBlock>);
   auto& ws = data.derivatives;
@@ -259,17 +261,25 @@ void tangent_step_derivatives(const ChainT& chain, typename ChainT::Data& data, 
   const auto k = static_cast<std::size_t>(s);
   constexpr int n = Segment::nq;
   using SegmentAD = decltype(seg.template cast<AD>());
-  // calc() in AutoDiff, direction j along q_j.
+  // calc_motion() in AutoDiff, direction j along q_j; the inertia's second derivatives in
+  // double (only InertiaRate::Consistent reads them).
   segment_to_autodiff(chain, ws.chain, s);
   for (int j = 0; j < n; ++j) ws.q(offset + j).derivatives() = AD::DerType::Unit(j);
   const typename SegmentAD::Kinematics* kin_ad = nullptr;
   ws.chain.visit_segment(ws.data, s, [&](const auto& seg_ad, auto& kin_s, int, int) {
     if constexpr (std::is_same_v<std::decay_t<decltype(seg_ad)>, SegmentAD>) {
-      seg_ad.calc(segment_entries<n>(ws.q, offset), segment_entries<n>(ws.qdot, offset), kin_s);
+      seg_ad.calc_motion(segment_entries<n>(ws.q, offset), segment_entries<n>(ws.qdot, offset),
+                         kin_s);
       kin_ad = &kin_s;
     }
   });
   for (int j = 0; j < n; ++j) ws.q(offset + j).derivatives().setZero();
+  SOFTRNE_ASSERT(kin_ad != nullptr, "the AutoDiff chain's segment has another type");
+  const bool consistent = rate == InertiaRate::Consistent;
+  InertiaHessianTimes<n> hessian_omega;
+  if (consistent)
+    seg.inertia_hessian_times(segment_entries<n>(q, offset), kin, data.motion[k + 1].omega,
+                              hessian_omega);
 
   const auto qd = segment_entries<n>(qdot, offset);
   const auto qdd = segment_entries<n>(qddot, offset);
@@ -288,7 +298,8 @@ void tangent_step_derivatives(const ChainT& chain, typename ChainT::Data& data, 
   for (int j = 0; j < n; ++j) {
     const int i = offset + j;  // the block: column 0 along q_i, column 1 along qdot_i
     KinematicsTangent<n> t[kDerivativeBlock];
-    kinematics_tangents<n>(*kin_ad, kin, qd, j, t[0], t[1]);
+    kinematics_tangents<n>(*kin_ad, kin, consistent ? &hessian_omega : nullptr, point.dI_omega,
+                           qd, j, t[0], t[1]);
     FrameMotion<double> d_distal[kDerivativeBlock];
     BodyLoad<double> d_load[kDerivativeBlock];
     Eigen::Matrix<double, 6, kDerivativeBlock> dV, dA;
@@ -450,7 +461,7 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
       if constexpr (is_fixed_axis_joint<Segment>::value)
         fixed_axis_derivatives(data, s, offset);
       else if constexpr (has_tangent_steps<Segment, kDerivativeBlock>)
-        tangent_step_derivatives(chain, data, s, offset, seg, kin, qdot, qddot);
+        tangent_step_derivatives(chain, data, s, offset, seg, kin, q, qdot, qddot);
       else if constexpr (Segment::nq > 0)
         autodiff_segment_derivatives<Segment::nq>(chain, data, s, offset);
       // (a segment without coordinates, a rigid link, has no columns)

@@ -6,15 +6,19 @@
 /// from the derivatives of the segment's kinematics (KinematicsTangent).
 ///
 /// ## Where the kinematics' derivatives come from
-/// calc() runs once per segment in AutoDiff, seeded along its coordinates q_j only. Along a
-/// rate qdot_j nothing needs another evaluation: by the definitions of SegmentKinematics, calc's
-/// outputs depend on qdot only through \f$\dot J\dot q = (\sum_k \partial J/\partial q_k\,\dot
-/// q_k)\,\dot q\f$ (for J_distal and J_com) and \f$\dot I = \sum_k \partial I/\partial q_k\,\dot
-/// q_k\f$, so \f$\partial(\dot J\dot q)/\partial\dot q_j = \dot J e_j + (\partial J/\partial
-/// q_j)\dot q\f$ and \f$\partial\dot I/\partial\dot q_j = \partial I/\partial q_j\f$, both
-/// from the derivatives along q. (Until 2026-12-07 calc, forward_step and backward_step ran in
-/// AutoDiff once per coordinate, seeded along (q_j, qdot_j): 62k of the 100k instructions of
-/// rnea_derivatives on the paper's arm.)
+/// calc_motion() (calc without the inertia) runs once per segment in AutoDiff, seeded along its
+/// coordinates q_j only. Along a rate qdot_j nothing needs another evaluation: by the
+/// definitions of SegmentKinematics, calc's outputs depend on qdot only through \f$\dot J\dot q
+/// = (\sum_k \partial J/\partial q_k\,\dot q_k)\,\dot q\f$ (for J_distal and J_com) and
+/// \f$\dot I = \sum_k \partial I/\partial q_k\,\dot q_k\f$, so \f$\partial(\dot J\dot
+/// q)/\partial\dot q_j = \dot J e_j + (\partial J/\partial q_j)\dot q\f$ and \f$\partial\dot
+/// I/\partial\dot q_j = \partial I/\partial q_j\f$, both from the derivatives along q. The
+/// inertia's derivative along q_j is calc's own dinertia_dq[j]; its second derivatives come
+/// from the segment's inertia_hessian_times, applied to the distal angular velocity
+/// \f$\omega^i\f$, the only vector the steps apply them to. (Until 2026-12-07 calc,
+/// forward_step and backward_step ran in AutoDiff once per coordinate, seeded along (q_j,
+/// qdot_j): 62k of the 100k instructions of rnea_derivatives on the paper's arm; then the
+/// whole calc once per joint, its inertia part 10.5k of 55.6k.)
 ///
 /// ## The tangent steps
 /// The product rule on eqs. 11-18 as forward_step and backward_step write them (lumped body;
@@ -34,6 +38,7 @@
 #include <array>
 #include <cstddef>
 #include <type_traits>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -45,19 +50,40 @@
 namespace softrne {
 namespace detail {
 
+/// \brief The second derivatives of a segment's inertia_com with respect to its coordinates,
+/// applied to the distal angular velocity: [i][j] = \f$(\partial^2 I/\partial q_i\partial
+/// q_j)\,\omega^i\f$ (distal axes).
+template <int NQ>
+using InertiaHessianTimes = std::array<std::array<Eigen::Vector3d, static_cast<std::size_t>(NQ)>,
+                                       static_cast<std::size_t>(NQ)>;
+
+/// \brief true for a segment with `calc_motion` (calc without the inertia) and
+/// `inertia_hessian_times` (the CC joint with LumpedInertia).
+template <class Segment, class = void>
+struct has_inertia_hessian : std::false_type {};
+template <class Segment>
+struct has_inertia_hessian<
+    Segment, std::void_t<decltype(std::declval<const Segment&>().inertia_hessian_times(
+                             std::declval<const Eigen::Matrix<double, Segment::nq, 1>&>(),
+                             std::declval<const typename Segment::Kinematics&>(),
+                             std::declval<const Eigen::Vector3d&>(),
+                             std::declval<InertiaHessianTimes<Segment::nq>&>()))>>
+    : std::true_type {};
+
 /// \brief true for a segment whose perturbation derivatives.hpp takes through the tangent steps
 /// of this file: one lumped body (no sub-bodies), a rotation and a translation that both move,
-/// and at most as many coordinates as one AutoDiff evaluation carries (the CC joint with
-/// LumpedInertia). Other segments are evaluated in AutoDiff whole.
+/// at most as many coordinates as one AutoDiff evaluation carries, and the second derivatives
+/// of its inertia written out (the CC joint with LumpedInertia). Other segments are evaluated
+/// in AutoDiff whole.
 template <class Segment, int MaxCoordinates>
 inline constexpr bool has_tangent_steps =
     Segment::has_body && (num_sub_bodies<Segment> == 0) &&
     !has_identity_rotation<Segment>::value && !has_zero_translation<Segment>::value &&
-    Segment::nq >= 1 && Segment::nq <= MaxCoordinates;
+    Segment::nq >= 1 && Segment::nq <= MaxCoordinates && has_inertia_hessian<Segment>::value;
 
 /// \brief The derivative of a segment's kinematics (SegmentKinematics' fields, same names
 /// shortened) along one direction: a coordinate q_j, or a rate qdot_j (`rate` = j). Along a
-/// rate only Jdq, Jdq_c, I_rate and rate are set (kinematics_tangents).
+/// rate only Jdq, Jdq_c, I_rate_omega and rate are set (kinematics_tangents).
 template <int NQ>
 struct KinematicsTangent {
   using Matrix3 = Eigen::Matrix3d;
@@ -70,8 +96,10 @@ struct KinematicsTangent {
   Eigen::Matrix<double, 3, NQ> J_c;                         ///< of J_com
   Vector3 Jdq_c;                                            ///< of Jdot_qdot_com
   Matrix3 I;                                                ///< of inertia_com
-  Matrix3 I_rate;                                           ///< of inertia_rate
-  std::array<Matrix3, static_cast<std::size_t>(NQ)> dI_dq;  ///< of dinertia_dq
+  /// Of inertia_rate and of dinertia_dq, times the distal angular velocity omega^i at the
+  /// expansion point (the only vector the tangent steps apply them to).
+  Vector3 I_rate_omega;
+  std::array<Vector3, static_cast<std::size_t>(NQ)> dI_dq_omega;
   int rate = -1;  ///< j along qdot_j (qdot's derivative is e_j there), -1 along a coordinate
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
@@ -87,14 +115,22 @@ Eigen::Matrix<double, M::RowsAtCompileTime, M::ColsAtCompileTime> derivative_alo
 }
 
 /// \brief The kinematics' derivatives along q_j and along qdot_j (this file's comment).
-/// \param[in] ad The kinematics from calc() in AutoDiff, direction k of its derivatives along
-///   q_k (k < NQ), nothing along qdot.
+/// \param[in] ad The kinematics from calc_motion() in AutoDiff, direction k of its derivatives
+///   along q_k (k < NQ), nothing along qdot (its inertia fields are not read).
 /// \param[in] kin The same kinematics in double (the expansion point).
+/// \param[in] hessian_omega The inertia's second derivatives times omega^i (the segment's
+///   inertia_hessian_times), or null: then the tangents of inertia_rate and dinertia_dq are
+///   zero (InertiaRate::Neglect does not read them).
+/// \param[in] dI_omega dinertia_dq[k] omega^i (TangentPoint).
 /// \param[in] qdot The segment's rates at the expansion point.
 /// \param[in] j The coordinate.
 template <int NQ, class KinAD, class Kin, class Qd>
-void kinematics_tangents(const KinAD& ad, const Kin& kin, const Eigen::MatrixBase<Qd>& qdot, int j,
-                         KinematicsTangent<NQ>& along_q, KinematicsTangent<NQ>& along_qdot) {
+void kinematics_tangents(const KinAD& ad, const Kin& kin,
+                         const InertiaHessianTimes<NQ>* hessian_omega,
+                         const std::array<Eigen::Vector3d, static_cast<std::size_t>(NQ)>& dI_omega,
+                         const Eigen::MatrixBase<Qd>& qdot, int j, KinematicsTangent<NQ>& along_q,
+                         KinematicsTangent<NQ>& along_qdot) {
+  const auto jj = static_cast<std::size_t>(j);
   along_q.R = derivative_along(ad.R_base_distal, j);
   along_q.r_e = derivative_along(ad.r_base_distal, j);
   along_q.r_c = derivative_along(ad.r_base_com, j);
@@ -102,10 +138,17 @@ void kinematics_tangents(const KinAD& ad, const Kin& kin, const Eigen::MatrixBas
   along_q.Jdq = derivative_along(ad.Jdot_qdot_distal, j);
   along_q.J_c = derivative_along(ad.J_com, j);
   along_q.Jdq_c = derivative_along(ad.Jdot_qdot_com, j);
-  along_q.I = derivative_along(ad.inertia_com, j);
-  along_q.I_rate = derivative_along(ad.inertia_rate, j);
-  for (std::size_t k = 0; k < static_cast<std::size_t>(NQ); ++k)
-    along_q.dI_dq[k] = derivative_along(ad.dinertia_dq[k], j);
+  // The inertia: its first derivative is calc's; inertia_rate = sum_k dI/dq_k qdot_k.
+  along_q.I = kin.dinertia_dq[jj];
+  along_q.I_rate_omega.setZero();
+  for (std::size_t k = 0; k < static_cast<std::size_t>(NQ); ++k) {
+    if (hessian_omega) {
+      along_q.dI_dq_omega[k] = (*hessian_omega)[jj][k];
+      along_q.I_rate_omega += qdot(static_cast<Eigen::Index>(k)) * (*hessian_omega)[jj][k];
+    } else {
+      along_q.dI_dq_omega[k].setZero();
+    }
+  }
 
   // Jdot e_j + (dJ/dq_j) qdot, with Jdot = sum_k (dJ/dq_k) qdot_k.
   Eigen::Matrix<double, 6, 1> Jdot_j = Eigen::Matrix<double, 6, 1>::Zero();
@@ -117,7 +160,7 @@ void kinematics_tangents(const KinAD& ad, const Kin& kin, const Eigen::MatrixBas
   // Along qdot_j every other derivative is zero; the tangent steps do not read them.
   along_qdot.Jdq.noalias() = Jdot_j + along_q.J * qdot;
   along_qdot.Jdq_c.noalias() = Jdot_c_j + along_q.J_c * qdot;
-  along_qdot.I_rate = kin.dinertia_dq[static_cast<std::size_t>(j)];
+  along_qdot.I_rate_omega = dI_omega[jj];
   along_qdot.rate = j;
 }
 
@@ -163,8 +206,8 @@ TangentPoint<Segment::nq> tangent_point(const typename Segment::Kinematics& kin,
 /// \brief The derivative of forward_step (velocity terms on) along t: of the distal frame's
 /// motion and of the segment's load; distal and load are forward_step's outputs at the
 /// expansion point, p their TangentPoint.
-/// \tparam AlongRate t is along a rate qdot_j: only t.Jdq, t.Jdq_c, t.I_rate and t.rate are
-///   read (every other derivative of the kinematics is zero there).
+/// \tparam AlongRate t is along a rate qdot_j: only t.Jdq, t.Jdq_c, t.I_rate_omega and t.rate
+///   are read (every other derivative of the kinematics is zero there).
 template <bool AlongRate, class Segment, class Qd, class Qdd>
 void tangent_forward_step(const Segment& seg, const typename Segment::Kinematics& kin,
                           const FrameMotion<double>& base, const Eigen::MatrixBase<Qd>& qdot,
@@ -221,7 +264,7 @@ void tangent_forward_step(const Segment& seg, const typename Segment::Kinematics
   Vector3 d_torque = times(I, d_distal.alpha) + cross3(d_om, p.I_omega) + cross3(om, d_I_om);
   if constexpr (!AlongRate) d_torque += times(t.I, distal.alpha);
   if (inertia_rate == InertiaRate::Consistent)
-    d_torque += times(t.I_rate, om) + times(kin.inertia_rate, d_om);
+    d_torque += t.I_rate_omega + times(kin.inertia_rate, d_om);
   d_load.torque = times(R, d_torque);
   if constexpr (!AlongRate) d_load.torque += times(t.R, p.torque_distal);
   d_load.omega_distal = d_om;
@@ -265,7 +308,7 @@ void tangent_backward_step(const typename Segment::Kinematics& kin, const BodyLo
     for (int k = 0; k < nq; ++k) {
       const auto kk = static_cast<std::size_t>(k);
       d_tau(k) -= d_om.dot(p.dI_omega[kk]);
-      if constexpr (!AlongRate) d_tau(k) -= 0.5 * om.dot(times(t.dI_dq[kk], om));
+      if constexpr (!AlongRate) d_tau(k) -= 0.5 * om.dot(t.dI_dq_omega[kk]);
     }
   }
   d_base.force = dF + d_load.force;

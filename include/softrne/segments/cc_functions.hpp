@@ -57,31 +57,50 @@ constexpr int cc_series_terms() {
   return n;
 }
 
-/// Coefficients \f$(-1)^n/(2n+K)!\f$ of \f$g_K\f$.
-template <int K>
+/// Coefficients of the series of \f$g_K^{(D)}\f$ (the D-th derivative in y) in powers of y:
+/// \f$(-1)^{m+D}(m+1)\cdots(m+D)/(2(m+D)+K)!\f$ (D = 0: \f$(-1)^m/(2m+K)!\f$).
+template <int K, int D = 0>
 struct CCSeries {
   static constexpr std::array<long double, kCCMaxSeriesTerms> make() {
     std::array<long double, kCCMaxSeriesTerms> c{};
-    for (int n = 0; n < kCCMaxSeriesTerms; ++n)
-      c[static_cast<std::size_t>(n)] = (n % 2 == 0 ? 1.0L : -1.0L) / factorial(2 * n + K);
+    for (int m = 0; m < kCCMaxSeriesTerms; ++m) {
+      long double rising = 1;  // (m+1)...(m+D)
+      for (int i = 1; i <= D; ++i) rising *= m + i;
+      c[static_cast<std::size_t>(m)] =
+          ((m + D) % 2 == 0 ? 1.0L : -1.0L) * rising / factorial(2 * (m + D) + K);
+    }
     return c;
   }
   static constexpr std::array<long double, kCCMaxSeriesTerms> coeffs = make();
 };
 
-/// \f$g_6(y)\f$ and \f$g_7(y)\f$ by their series (Horner, both in one loop), y < 1.
-template <class Scalar>
-void cc_series_g67(const Scalar& y, Scalar& g6, Scalar& g7) {
+/// Two series of CCSeries' form at y < 1, by Horner in one loop, with cc_series_terms terms.
+template <class SeriesA, class SeriesB, class Scalar>
+void cc_series_pair(const Scalar& y, Scalar& a, Scalar& b) {
   using Real = typename Eigen::NumTraits<Scalar>::Real;
   constexpr int N = cc_series_terms<Real>();
-  const auto& c6 = CCSeries<6>::coeffs;
-  const auto& c7 = CCSeries<7>::coeffs;
-  g6 = Scalar(Real(c6[N - 1]));
-  g7 = Scalar(Real(c7[N - 1]));
+  const auto& ca = SeriesA::coeffs;
+  const auto& cb = SeriesB::coeffs;
+  a = Scalar(Real(ca[N - 1]));
+  b = Scalar(Real(cb[N - 1]));
   for (int j = N - 2; j >= 0; --j) {
-    g6 = g6 * y + Scalar(Real(c6[static_cast<std::size_t>(j)]));
-    g7 = g7 * y + Scalar(Real(c7[static_cast<std::size_t>(j)]));
+    a = a * y + Scalar(Real(ca[static_cast<std::size_t>(j)]));
+    b = b * y + Scalar(Real(cb[static_cast<std::size_t>(j)]));
   }
+}
+
+/// \f$g_6(y)\f$ and \f$g_7(y)\f$ by their series, y < 1.
+template <class Scalar>
+void cc_series_g67(const Scalar& y, Scalar& g6, Scalar& g7) {
+  cc_series_pair<CCSeries<6>, CCSeries<7>>(y, g6, g7);
+}
+
+/// \f$g_4''(y)\f$ and \f$g_5''(y)\f$ by their series, y < 1. Their terms fall faster than
+/// those of g_6 (cc_series_terms): the first dropped one, relative to the sum, is below 1e-17
+/// for double.
+template <class Scalar>
+void cc_series_g45_second(const Scalar& y, Scalar& g4, Scalar& g5) {
+  cc_series_pair<CCSeries<4, 2>, CCSeries<5, 2>>(y, g4, g5);
 }
 
 /// \brief \f$g_0..g_3\f$ and their first two derivatives at one argument.
@@ -204,6 +223,36 @@ struct CCArcFunctions {
     d3 = (at_x.g[3] - at_4x.g[3]) * inv_x;
     dd2 = (at_x.dg[2] - Scalar(4) * at_4x.dg[2] - d2) * inv_x;
     dd3 = (at_x.dg[3] - Scalar(4) * at_4x.dg[3] - d3) * inv_x;
+  }
+
+  /// \brief The second derivatives with respect to x that the inertia's second derivatives
+  /// need (after compute(x)): \f$d^2 g_k(4x)/dx^2 = 16 g_k''(4x)\f$ into ddG[k - 2] and
+  /// \f$d_k''(x)\f$ into ddd[k - 2], k = 2, 3.
+  ///
+  /// Below kCCDiffSwitch, from the series: \f$g_k'' = (k g_{k+2}' - g_{k+1}')/2\f$ at 4x and
+  /// \f$d_k'' = 64 g_{k+2}''(4x) - g_{k+2}''(x)\f$ (the second derivative of the identity of
+  /// d_k; no cancellation). At or above it, 4x >= 1: the closed-form recurrence at 4x and
+  /// \f$d_k'' = (g_k''(x) - 16 g_k''(4x) - 2 d_k')/x\f$, the second derivative of
+  /// \f$x d_k = g_k(x) - g_k(4x)\f$ (about one digit lost to cancellation at the switch).
+  void second_derivatives(const Scalar& x, Scalar (&ddG)[2], Scalar (&ddd)[2]) const {
+    Scalar g_4x[2];  // g_2'', g_3'' at 4x (with respect to their argument)
+    if (x < Scalar(kCCDiffSwitch)) {
+      g_4x[0] = (Scalar(2) * at_4x.dg45[0] - at_4x.dg[3]) / Scalar(2);
+      g_4x[1] = (Scalar(3) * at_4x.dg45[1] - at_4x.dg45[0]) / Scalar(2);
+      Scalar g45_x[2], g45_4x[2];
+      cc_series_g45_second(x, g45_x[0], g45_x[1]);
+      cc_series_g45_second(Scalar(4) * x, g45_4x[0], g45_4x[1]);
+      for (int k = 0; k < 2; ++k) ddd[k] = Scalar(64) * g45_4x[k] - g45_x[k];
+    } else {
+      const Scalar inv_x = Scalar(1) / x;
+      const Scalar half_inv_y = Scalar(0.125) * inv_x;  // 1 / (2 (4x))
+      const Scalar dg1 = (at_4x.g[0] - at_4x.g[1]) * half_inv_y;
+      g_4x[0] = (dg1 - Scalar(4) * at_4x.dg[2]) * half_inv_y;
+      g_4x[1] = (at_4x.dg[2] - Scalar(5) * at_4x.dg[3]) * half_inv_y;
+      ddd[0] = (at_x.ddg[2] - Scalar(16) * g_4x[0] - Scalar(2) * dd2) * inv_x;
+      ddd[1] = (at_x.ddg[3] - Scalar(16) * g_4x[1] - Scalar(2) * dd3) * inv_x;
+    }
+    for (int k = 0; k < 2; ++k) ddG[k] = Scalar(16) * g_4x[k];
   }
 };
 

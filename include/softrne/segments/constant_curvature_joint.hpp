@@ -196,6 +196,136 @@ struct ConstantCurvatureJoint {
     }
   }
 
+  /// \brief calc() without the inertia (lumped model): the pose, Jacobians and their rates
+  /// only; inertia_com, dinertia_dq and inertia_rate are left as they are. The derivatives
+  /// (algorithms/derivatives.hpp) run this in AutoDiff and take the inertia's derivatives from
+  /// calc() and inertia_hessian_times() instead.
+  template <class Q, class Qd>
+  void calc_motion(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
+                   Kinematics& kin) const {
+    static_assert(!distributed, "calc_motion: the lumped model only");
+    const Scalar u = q(0), v = q(1);
+    detail::CCFunctions<Scalar> f;  // the same functions at x as calc's CCArcFunctions
+    f.compute(u * u + v * v);
+    arc_kinematics<true>(f, u, v, qdot(0), qdot(1), height, kin.R_base_distal,
+                         kin.r_base_distal, kin.J_distal, kin.Jdot_qdot_distal, kin.r_base_com,
+                         kin.J_com, kin.Jdot_qdot_com);
+  }
+
+  /// \brief The second derivatives of the lumped inertia about the centre of mass (distal
+  /// axes, eq. 19) applied to a vector w: out[i][j] = \f$(\partial^2 I^i/\partial q_i\partial
+  /// q_j)\,w\f$. (The derivatives' tangent steps need them only against the distal angular
+  /// velocity, so no 3 x 3 matrix is formed.)
+  ///
+  /// With \f$\Phi(X) = R^T X R\f$ and \f$\partial_i R = R[w'_i]_\times\f$ (w'_i: the right
+  /// Jacobian's column, inertia_terms), \f$\partial_i\Phi(X) = \Phi(\partial_i X) + C(\Phi(X),
+  /// w'_i)\f$ with \f$C(A, w) = A[w]_\times - [w]_\times A\f$, so \f$C(A, w)y = A(w\times y) -
+  /// w\times Ay\f$. Applied twice to \f$I^b\f$:
+  /// \f[ \partial_i\partial_j I^i = T_{ij} + C(T_j, w'_i) + C(T_i, w'_j)
+  ///     + C(C(I^i, w'_i), w'_j) + C(I^i, \partial_i w'_j), \f]
+  /// \f$T_j = \Phi(\partial_j I^b) = 2q_j D + a_w S^p_j + a_{wz} S^e_j\f$ (calc_inertia's
+  /// terms, \f$S^p_j = \mathrm{sym}(p_j, p)\f$, \f$S^e_j = \mathrm{sym}(p_j, e)\f$,
+  /// \f$\mathrm{sym}(a, b) = ab^T + ba^T\f$) and \f$T_{ij} = \Phi(\partial_i\partial_j I^b) =
+  /// 2\delta_{ij}D + 4q_iq_j D_2 + 2q_j(a_w' S^p_i + a_{wz}' S^e_i) + 2q_i(a_w' S^p_j + a_{wz}'
+  /// S^e_j) + a_w\,\mathrm{sym}(p_i, p_j)\f$, with \f$D_2\f$ the coefficients' second
+  /// derivatives in x on the same basis. Tested against calc() in AutoDiff, at phi = 0 and
+  /// across the series switches (tests/core/test_derivatives.cpp, KinematicsTangents.*).
+  /// \param[in] q (u, v), rad.
+  /// \param[in] kin calc()'s output at q (its R_base_distal, inertia_com are read).
+  /// \param[in] w The vector (distal axes).
+  /// \param[out] out The 2 x 2 symmetric block of vectors.
+  template <class Q>
+  void inertia_hessian_times(const Eigen::MatrixBase<Q>& q, const Kinematics& kin,
+                             const Vector3& w,
+                             std::array<std::array<Vector3, nq>, nq>& out) const {
+    static_assert(!distributed, "inertia_hessian_times: the lumped model only");
+    const Scalar u = q(0), v = q(1);
+    const Scalar x = u * u + v * v;
+    detail::CCArcFunctions<Scalar> f;
+    f.compute(x);
+    const InertiaTerms t = inertia_terms(f, u, v, kin.R_base_distal);
+    const auto& g = f.at_x.g;
+    const auto& dg = f.at_x.dg;
+    const auto& ddg = f.at_x.ddg;
+    Scalar ddG[2], ddd[2];  // d^2/dx^2 of g_2, g_3 at 4x; d_2'', d_3''
+    f.second_derivatives(x, ddG, ddd);
+    const Scalar dG3 = Scalar(4) * f.at_4x.dg[3];
+    const Scalar md = mass * diameter * diameter / Scalar(16);
+    const Scalar mh = mass * height * height;
+    // The second derivatives in x of (s0, a_w, a_wz, a_z) (inertia_terms' first ones, again).
+    const Scalar dds0 =
+        Scalar(2) * mh * ddg[3] -
+        mh * (Scalar(4) * g[3] * dg[3] + Scalar(2) * x * (dg[3] * dg[3] + g[3] * ddg[3]) +
+              Scalar(2) * (dg[2] * dg[2] + g[2] * ddg[2]));
+    const Scalar dda_w = Scalar(2) * md * ddG[1] - Scalar(2) * mh * ddd[1] +
+                         Scalar(2) * mh * (dg[3] * dg[3] + g[3] * ddg[3]);
+    const Scalar dda_wz = md * ddG[0] - mh * ddd[0] +
+                          mh * (ddg[3] * g[2] + Scalar(2) * dg[3] * dg[2] + g[3] * ddg[2]);
+    const Scalar dda_z = -Scalar(2) * md * (Scalar(2) * dG3 + x * ddG[1]) -
+                         Scalar(2) * mh * ddG[1] + Scalar(2) * mh * (dg[2] * dg[2] + g[2] * ddg[2]);
+
+    const Vector3& p = t.p;
+    const Vector3& e = t.e;
+    const Scalar pw = p.dot(w), ew = e.dot(w);
+    // D_2 w, and the vectors through which S^p_j, S^e_j act: a_w S^p_j + a_wz S^e_j = sym(p_j, m)
+    // and a_w' S^p_j + a_wz' S^e_j = sym(p_j, n).
+    const Vector3 D2w = dds0 * w + (dda_w * pw + dda_wz * ew) * p + (dda_wz * pw + dda_z * ew) * e;
+    const Vector3 m = t.a_w * p + t.a_wz * e, n = t.da_w * p + t.da_wz * e;
+    const Scalar nw = n.dot(w), dpw[2] = {t.dp[0].dot(w), t.dp[1].dot(w)};
+    const Scalar qj[2] = {u, v};
+    // T_j y = 2 q_j D y + p_j (m.y) + m (p_j.y).
+    auto T_times = [&](int j, const Vector3& y, const Vector3& Dy) -> Vector3 {
+      return Scalar(2) * qj[j] * Dy + m.dot(y) * t.dp[j] + t.dp[j].dot(y) * m;
+    };
+    // I^i (calc's) and D = R^T (dI^b/dx) R times a vector.
+    const Matrix3& I = kin.inertia_com;
+    auto D_times = [&](const Vector3& y) -> Vector3 {
+      const Scalar py = p.dot(y), ey = e.dot(y);
+      return t.ds0 * y + (t.da_w * py + t.da_wz * ey) * p + (t.da_wz * py + t.da_z * ey) * e;
+    };
+    const Vector3 Iw = I * w, Dw = D_times(w);
+    Vector3 c[2], Ic[2], Dc[2], CIw[2];  // c_i = w'_i x w, I c_i, D c_i, C(I, w'_i) w
+    for (int i = 0; i < 2; ++i) {
+      c[i] = t.wr[i].cross(w);
+      Ic[i] = I * c[i];
+      Dc[i] = D_times(c[i]);
+      CIw[i] = Ic[i] - t.wr[i].cross(Iw);
+    }
+    Vector3 Tw[2], Tc[2][2];  // T_j w, T_j c_i
+    for (int j = 0; j < 2; ++j) {
+      Tw[j] = T_times(j, w, Dw);
+      for (int i = 0; i < 2; ++i) Tc[j][i] = T_times(j, c[i], Dc[i]);
+    }
+    const Scalar uu = u * u, vv = v * v, uv = u * v;
+    for (int i = 0; i < 2; ++i) {
+      const Scalar c3 = Scalar(2) * qj[i] * dg[3], c2 = Scalar(2) * qj[i] * dg[2];
+      // d_i of the monomials v^2, u v, v, u^2, u.
+      const Scalar dvv = i == 1 ? Scalar(2) * v : Scalar(0), duv = i == 0 ? v : u;
+      const Scalar dv = Scalar(i == 1 ? 1 : 0), duu = i == 0 ? Scalar(2) * u : Scalar(0);
+      const Scalar du = Scalar(i == 0 ? 1 : 0);
+      const Vector3 dwr[2] = {
+          Vector3(-c3 * vv - g[3] * dvv, c3 * uv + g[3] * duv, c2 * v + g[2] * dv),
+          Vector3(c3 * uv + g[3] * duv, -c3 * uu - g[3] * duu, -c2 * u - g[2] * du)};
+      for (int j = i; j < 2; ++j) {
+        // T_ij w
+        Vector3 h = Scalar(4) * qj[i] * qj[j] * D2w +
+                    Scalar(2) * qj[j] * (nw * t.dp[i] + dpw[i] * n) +
+                    Scalar(2) * qj[i] * (nw * t.dp[j] + dpw[j] * n) +
+                    t.a_w * (dpw[j] * t.dp[i] + dpw[i] * t.dp[j]);
+        if (i == j) h += Scalar(2) * Dw;
+        // C(T_j, w'_i) w + C(T_i, w'_j) w
+        h += Tc[j][i] - t.wr[i].cross(Tw[j]) + Tc[i][j] - t.wr[j].cross(Tw[i]);
+        // C(C(I, w'_i), w'_j) w, with C(I, w'_i) y = I (w'_i x y) - w'_i x I y
+        const Vector3 wc = t.wr[i].cross(c[j]);
+        h += I * wc - t.wr[i].cross(Ic[j]) - t.wr[j].cross(CIw[i]);
+        // C(I, d_i w'_j) w
+        h += I * dwr[j].cross(w) - dwr[j].cross(Iw);
+        out[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] = h;
+        if (j != i) out[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)] = h;
+      }
+    }
+  }
+
   /// \brief Generalised forces of the chamber pressures (eq. 24 or a custom layout).
   /// \param[in] pressures One pressure per chamber (num_inputs()), Pa.
   /// \return \f$K_{prs}p\f$ = (tau_u, tau_v), N m.
@@ -371,58 +501,29 @@ struct ConstantCurvatureJoint {
   /// Also fills dinertia_dq and inertia_rate.
   void calc_inertia(const detail::CCArcFunctions<Scalar>& f, const Scalar& u, const Scalar& v,
                     const Scalar& ud, const Scalar& vd, Kinematics& kin) const {
-    const auto& g = f.at_x.g;
-    const auto& dg = f.at_x.dg;
-    const Scalar x = u * u + v * v;
-    const Scalar G2 = f.at_4x.g[2], G3 = f.at_4x.g[3];
-    const Scalar dG2 = Scalar(4) * f.at_4x.dg[2], dG3 = Scalar(4) * f.at_4x.dg[3];  // d/dx
-    const Scalar md = mass * diameter * diameter / Scalar(16);
-    const Scalar mh = mass * height * height;
-
-    const Scalar s0 = md + Scalar(2) * mh * g[3] - mh * (x * g[3] * g[3] + g[2] * g[2]);
-    const Scalar a_w = Scalar(2) * md * G3 - Scalar(2) * mh * f.d3 + mh * g[3] * g[3];
-    const Scalar a_wz = md * G2 - mh * f.d2 + mh * g[3] * g[2];
-    const Scalar a_z =
-        md * (Scalar(1) - Scalar(2) * x * G3) - Scalar(2) * mh * G3 + mh * g[2] * g[2];
-
-    const Scalar ds0 = Scalar(2) * mh * dg[3] -
-                       mh * (g[3] * g[3] + Scalar(2) * x * g[3] * dg[3] + Scalar(2) * g[2] * dg[2]);
-    const Scalar da_w =
-        Scalar(2) * md * dG3 - Scalar(2) * mh * f.dd3 + Scalar(2) * mh * g[3] * dg[3];
-    const Scalar da_wz = md * dG2 - mh * f.dd2 + mh * (dg[3] * g[2] + g[3] * dg[2]);
-    const Scalar da_z = md * (-Scalar(2) * G3 - Scalar(2) * x * dG3) - Scalar(2) * mh * dG3 +
-                        Scalar(2) * mh * g[2] * dg[2];
-
-    const Matrix3& R = kin.R_base_distal;
-    const Scalar c0 = R(2, 2);  // = g0 = cos(phi), as R computes it
-    const Vector3 p(c0 * v, -c0 * u, g[1] * x);
-    const Vector3 e = R.row(2).transpose();
+    const InertiaTerms t = inertia_terms(f, u, v, kin.R_base_distal);
     // Symmetric matrices as their 6 entries (xx, yy, zz, xy, xz, yz).
-    const Sym PP = outer(p), EE = outer(e), PE = sym(p, e);
+    const Sym PP = outer(t.p), EE = outer(t.e), PE = sym(t.p, t.e);
     Sym I, D;  // I^i, and R^T (dI^b/dx) R
     for (int k = 0; k < 6; ++k) {
-      I[k] = a_w * PP[k] + a_wz * PE[k] + a_z * EE[k];
-      D[k] = da_w * PP[k] + da_wz * PE[k] + da_z * EE[k];
+      I[k] = t.a_w * PP[k] + t.a_wz * PE[k] + t.a_z * EE[k];
+      D[k] = t.da_w * PP[k] + t.da_wz * PE[k] + t.da_z * EE[k];
     }
     for (int k = 0; k < 3; ++k) {
-      I[k] += s0;
-      D[k] += ds0;
+      I[k] += t.s0;
+      D[k] += t.ds0;
     }
     to_matrix(I, kin.inertia_com);
-
     // dI^i/dq_j = R^T (dI^b/dq_j) R + I^i [w'_j]x - [w'_j]x I^i, since dR/dq_j = [w_j]x R with
     // w_j the j-th angular Jacobian column and w'_j = R^T w_j the j-th column of the right
     // Jacobian J_r = R^T J_l = I - g2 [w]x + g3 [w]x^2; R^T dw_perp/dq_j = R^T (-e_y), R^T e_x.
     const Scalar qj[2] = {u, v};
-    const Vector3 dp[2] = {-R.row(1).transpose(), R.row(0).transpose()};
-    const Vector3 wr[2] = {Vector3(Scalar(1) - g[3] * v * v, g[3] * u * v, g[2] * v),
-                           Vector3(g[3] * u * v, Scalar(1) - g[3] * u * u, -g[2] * u)};
     Sym rate;
     for (int j = 0; j < 2; ++j) {
-      const Sym C = commutator(I, wr[j]), Sp = sym(dp[j], p), Se = sym(dp[j], e);
+      const Sym C = commutator(I, t.wr[j]), Sp = sym(t.dp[j], t.p), Se = sym(t.dp[j], t.e);
       const Scalar two_q = Scalar(2) * qj[j];
       Sym dI;
-      for (int k = 0; k < 6; ++k) dI[k] = two_q * D[k] + a_w * Sp[k] + a_wz * Se[k] + C[k];
+      for (int k = 0; k < 6; ++k) dI[k] = two_q * D[k] + t.a_w * Sp[k] + t.a_wz * Se[k] + C[k];
       to_matrix(dI, kin.dinertia_dq[static_cast<std::size_t>(j)]);
       if (j == 0)
         for (int k = 0; k < 6; ++k) rate[k] = dI[k] * ud;
@@ -430,6 +531,46 @@ struct ConstantCurvatureJoint {
         for (int k = 0; k < 6; ++k) rate[k] += dI[k] * vd;
     }
     to_matrix(rate, kin.inertia_rate);
+  }
+
+  /// What calc_inertia and inertia_hessian_times share: the coefficients of
+  /// \f$I^b = s_0\mathbf 1 + a_w w_\perp w_\perp^T + a_{wz}(w_\perp e_z^T + e_z w_\perp^T) + a_z
+  /// e_z e_z^T\f$ and their derivatives in x, the vectors p, e (calc_inertia's comment), p_j =
+  /// R^T dw_perp/dq_j, and the right Jacobian's columns w'_j. (inertia_terms is always inlined:
+  /// out of line it cost rnea 0.8 % more instructions on the paper's arm.)
+  struct InertiaTerms {
+    Scalar s0, a_w, a_wz, a_z, ds0, da_w, da_wz, da_z;
+    Vector3 p, e, dp[2], wr[2];
+  };
+  EIGEN_ALWAYS_INLINE InertiaTerms inertia_terms(const detail::CCArcFunctions<Scalar>& f,
+                                                 const Scalar& u, const Scalar& v,
+                                                 const Matrix3& R) const {
+    const auto& g = f.at_x.g;
+    const auto& dg = f.at_x.dg;
+    const Scalar x = u * u + v * v;
+    const Scalar G2 = f.at_4x.g[2], G3 = f.at_4x.g[3];
+    const Scalar dG2 = Scalar(4) * f.at_4x.dg[2], dG3 = Scalar(4) * f.at_4x.dg[3];  // d/dx
+    const Scalar md = mass * diameter * diameter / Scalar(16);
+    const Scalar mh = mass * height * height;
+    InertiaTerms t;
+    t.s0 = md + Scalar(2) * mh * g[3] - mh * (x * g[3] * g[3] + g[2] * g[2]);
+    t.a_w = Scalar(2) * md * G3 - Scalar(2) * mh * f.d3 + mh * g[3] * g[3];
+    t.a_wz = md * G2 - mh * f.d2 + mh * g[3] * g[2];
+    t.a_z = md * (Scalar(1) - Scalar(2) * x * G3) - Scalar(2) * mh * G3 + mh * g[2] * g[2];
+    t.ds0 = Scalar(2) * mh * dg[3] -
+            mh * (g[3] * g[3] + Scalar(2) * x * g[3] * dg[3] + Scalar(2) * g[2] * dg[2]);
+    t.da_w = Scalar(2) * md * dG3 - Scalar(2) * mh * f.dd3 + Scalar(2) * mh * g[3] * dg[3];
+    t.da_wz = md * dG2 - mh * f.dd2 + mh * (dg[3] * g[2] + g[3] * dg[2]);
+    t.da_z = md * (-Scalar(2) * G3 - Scalar(2) * x * dG3) - Scalar(2) * mh * dG3 +
+             Scalar(2) * mh * g[2] * dg[2];
+    const Scalar c0 = R(2, 2);  // = g0 = cos(phi), as R computes it
+    t.p = Vector3(c0 * v, -c0 * u, g[1] * x);
+    t.e = R.row(2).transpose();
+    t.dp[0] = -R.row(1).transpose();
+    t.dp[1] = R.row(0).transpose();
+    t.wr[0] = Vector3(Scalar(1) - g[3] * v * v, g[3] * u * v, g[2] * v);
+    t.wr[1] = Vector3(g[3] * u * v, Scalar(1) - g[3] * u * u, -g[2] * u);
+    return t;
   }
 
   /// A symmetric 3x3 matrix as (xx, yy, zz, xy, xz, yz).
