@@ -200,6 +200,9 @@ struct ConstantCurvatureJoint {
   /// only; inertia_com, dinertia_dq and inertia_rate are left as they are. The derivatives
   /// (algorithms/derivatives.hpp) run this in AutoDiff and take the inertia's derivatives from
   /// calc() and inertia_hessian_times() instead.
+  /// \param[in] q (u, v), rad.
+  /// \param[in] qdot (u', v'), rad/s (for the Jacobian rates).
+  /// \param[out] kin The segment's kinematics, but for the inertia fields.
   template <class Q, class Qd>
   void calc_motion(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
                    Kinematics& kin) const {
