@@ -269,10 +269,19 @@ struct ConstantCurvatureJoint {
 
     const Vector3& p = t.p;
     const Vector3& e = t.e;
-    const Scalar pw = p.dot(w), ew = e.dot(w);
-    // D_2 w, and the vectors through which S^p_j, S^e_j act: a_w S^p_j + a_wz S^e_j = sym(p_j, m)
-    // and a_w' S^p_j + a_wz' S^e_j = sym(p_j, n).
-    const Vector3 D2w = dds0 * w + (dda_w * pw + dda_wz * ew) * p + (dda_wz * pw + dda_z * ew) * e;
+    // (s 1 + a_w p p^T + a_wz (p e^T + e p^T) + a_z e e^T) y: D (first derivatives of the
+    // coefficients) and D_2 (second) on calc_inertia's basis, times a vector.
+    auto basis_times = [&](const Scalar& s, const Scalar& a_w, const Scalar& a_wz,
+                           const Scalar& a_z, const Vector3& y) -> Vector3 {
+      const Scalar py = p.dot(y), ey = e.dot(y);
+      return s * y + (a_w * py + a_wz * ey) * p + (a_wz * py + a_z * ey) * e;
+    };
+    auto D_times = [&](const Vector3& y) {
+      return basis_times(t.ds0, t.da_w, t.da_wz, t.da_z, y);
+    };
+    const Vector3 D2w = basis_times(dds0, dda_w, dda_wz, dda_z, w);
+    // The vectors through which S^p_j, S^e_j act: a_w S^p_j + a_wz S^e_j = sym(p_j, m) and
+    // a_w' S^p_j + a_wz' S^e_j = sym(p_j, n).
     const Vector3 m = t.a_w * p + t.a_wz * e, n = t.da_w * p + t.da_wz * e;
     const Scalar nw = n.dot(w), dpw[2] = {t.dp[0].dot(w), t.dp[1].dot(w)};
     const Scalar qj[2] = {u, v};
@@ -280,12 +289,7 @@ struct ConstantCurvatureJoint {
     auto T_times = [&](int j, const Vector3& y, const Vector3& Dy) -> Vector3 {
       return Scalar(2) * qj[j] * Dy + m.dot(y) * t.dp[j] + t.dp[j].dot(y) * m;
     };
-    // I^i (calc's) and D = R^T (dI^b/dx) R times a vector.
-    const Matrix3& I = kin.inertia_com;
-    auto D_times = [&](const Vector3& y) -> Vector3 {
-      const Scalar py = p.dot(y), ey = e.dot(y);
-      return t.ds0 * y + (t.da_w * py + t.da_wz * ey) * p + (t.da_wz * py + t.da_z * ey) * e;
-    };
+    const Matrix3& I = kin.inertia_com;  // I^i, calc's
     const Vector3 Iw = I * w, Dw = D_times(w);
     Vector3 c[2], Ic[2], Dc[2], CIw[2];  // c_i = w'_i x w, I c_i, D c_i, C(I, w'_i) w
     for (int i = 0; i < 2; ++i) {
