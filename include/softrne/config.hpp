@@ -26,6 +26,15 @@
   } while (false)
 #endif
 
+/// \brief Forces a lambda inline (`[&](auto k) SOFTRNE_LAMBDA_INLINE { ... }`), as
+/// EIGEN_ALWAYS_INLINE does a function: GCC otherwise leaves small generic lambdas out of line
+/// in the larger translation units (measured in mass_matrix, docs/performance.md).
+#if defined(__GNUC__)
+#define SOFTRNE_LAMBDA_INLINE __attribute__((always_inline))
+#else
+#define SOFTRNE_LAMBDA_INLINE
+#endif
+
 /// \brief Header-only or compiled: the heavy entry points of the arm layer (arm/, sim/:
 /// SOFTRNE_SIM_*) and of fit/ (SOFTRNE_FIT_*).
 ///

@@ -149,6 +149,52 @@ TEST(RneaIdentities, StaticChainEqualsRuntimeChain) {
   }
 }
 
+// mass_matrix() must leave data as compute_kinematics(q, 0) does (distal_placement() and the
+// other algorithms read it), and give the M that mass_matrix_and_bias() computes after
+// compute_kinematics(), whatever q the data held before. Both chain kinds, and the
+// distributed-inertia CC joint (its own sub-body path in the sweep).
+template <class ChainT, class VectorT>
+void check_mass_matrix_kinematics(const ChainT& chain, std::mt19937& rng) {
+  auto data = chain.make_data();
+  const int n = chain.num_coordinates();
+  for (int s = 0; s < 10; ++s) {
+    const VectorT q_before = softrne_test::random_vector(rng, n, 2.0);
+    const VectorT q = softrne_test::random_vector(rng, n, 2.0);
+    const VectorT qd = softrne_test::random_vector(rng, n, 2.0);
+    const VectorT zero = VectorT::Zero(n);
+    compute_kinematics(chain, data, q_before, qd);
+    const MatrixXd M = mass_matrix(chain, data, q);
+    for (int i = 0; i < data.num_segments(); ++i) {
+      const Placement<double> after_mass_matrix = distal_placement(chain, data, i);
+      compute_kinematics(chain, data, q, zero);
+      const Placement<double> reference = distal_placement(chain, data, i);
+      EXPECT_EQ(after_mass_matrix.R, reference.R);
+      EXPECT_EQ(after_mass_matrix.p, reference.p);
+      mass_matrix(chain, data, q);
+    }
+    compute_kinematics(chain, data, q_before, qd);
+    mass_matrix_and_bias(chain, data, q, qd);
+    EXPECT_LT(softrne_test::rel_err(data.mass_matrix, M), 1e-15);
+  }
+}
+
+TEST(RneaIdentities, MassMatrixLeavesTheKinematicsAtQ) {
+  std::mt19937 rng(41);
+  DynamicChain<double> dyn = hybrid();
+  dyn.add(softrne_test::random_cc<DistributedInertia<>>(rng), "distributed");
+  check_mass_matrix_kinematics<DynamicChain<double>, VectorXd>(dyn, rng);
+  using CC = ConstantCurvatureJoint<double>;
+  using CCD = ConstantCurvatureJoint<double, DistributedInertia<>>;
+  using RL = RigidLink<double>;
+  using RJ = RevoluteJoint<double>;
+  Chain<RJ, RL, CC, RL, CCD, RJ> st(softrne_test::random_rev(rng), softrne_test::random_link(rng),
+                                    softrne_test::random_cc(rng), softrne_test::random_link(rng),
+                                    softrne_test::random_cc<DistributedInertia<>>(rng),
+                                    softrne_test::random_rev(rng));
+  st.gravity << 0.0, 0.0, -9.81;
+  check_mass_matrix_kinematics<decltype(st), Eigen::Matrix<double, 6, 1>>(st, rng);
+}
+
 TEST(RneaClosedForm, SingleJointWithTipMassStaticEquilibrium) {
   // A CC joint with gravity sideways (-y) bending about x only, with a point-like tip mass M:
   // V(u) = g (m r_c,y + M r_e,y), r_e,y = -h (1 - cos u)/u, r_c,y = -h (u - sin u)/u^2, and

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/config.hpp"
 #include "softrne/segments/segment_kinematics.hpp"
 #include "softrne/spatial/axis_rotation.hpp"
 #include "softrne/spatial/skew.hpp"
@@ -76,7 +77,7 @@ struct RevoluteJoint {
     kin.J_distal.template bottomRows<3>() = axis;
     kin.coordinate_axis = coordinate_axis();
     if (kin.coordinate_axis >= 0) {  // about x, y or z: R turns one plane (i, j)
-      detail::with_axis(kin.coordinate_axis, [&](auto k) {
+      detail::with_axis(kin.coordinate_axis, [&](auto k) SOFTRNE_LAMBDA_INLINE {
         constexpr int i = detail::AxisPlane<k()>::I, j = detail::AxisPlane<k()>::J;
         Matrix3& R = kin.R_base_distal;
         R.setIdentity();

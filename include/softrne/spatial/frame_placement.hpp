@@ -26,6 +26,7 @@
 #include <Eigen/Core>
 
 #include "softrne/chain/motion.hpp"
+#include "softrne/config.hpp"
 #include "softrne/spatial/axis_rotation.hpp"
 #include "softrne/spatial/inertia_transforms.hpp"
 
@@ -126,8 +127,9 @@ class FramePlacement {
   EIGEN_ALWAYS_INLINE Vector3 rotate(const Eigen::MatrixBase<V>& v) const {
     if constexpr (AxisFastPath) {
       if (axis_ >= 0)
-        return detail::with_axis(axis_,
-                                 [&](auto k) { return detail::times_about_axis<k()>(R_, v); });
+        return detail::with_axis(axis_, [&](auto k) SOFTRNE_LAMBDA_INLINE {
+          return detail::times_about_axis<k()>(R_, v);
+        });
     }
     if constexpr (Turns) return detail::times(R_, v); else return v;
   }
@@ -139,8 +141,9 @@ class FramePlacement {
   EIGEN_ALWAYS_INLINE Vector3 rotate_back(const Eigen::MatrixBase<V>& v) const {
     if constexpr (AxisFastPath) {
       if (axis_ >= 0)
-        return detail::with_axis(
-            axis_, [&](auto k) { return detail::times_about_axis<k(), true>(R_, v); });
+        return detail::with_axis(axis_, [&](auto k) SOFTRNE_LAMBDA_INLINE {
+          return detail::times_about_axis<k(), true>(R_, v);
+        });
     }
     if constexpr (Turns) return detail::transpose_times(R_, v); else return v;
   }
@@ -212,8 +215,9 @@ class FramePlacement {
   EIGEN_ALWAYS_INLINE Matrix3 rotate_symmetric(const Matrix3& A) const {
     if constexpr (AxisFastPath) {
       if (axis_ >= 0)
-        return detail::with_axis(
-            axis_, [&](auto k) { return detail::rotate_symmetric_about_axis<k()>(R_, A); });
+        return detail::with_axis(axis_, [&](auto k) SOFTRNE_LAMBDA_INLINE {
+          return detail::rotate_symmetric_about_axis<k()>(R_, A);
+        });
     }
     if constexpr (Turns) return detail::rotate_symmetric(R_, A); else return A;
   }
@@ -221,7 +225,7 @@ class FramePlacement {
   /// \brief A rigid inertia about the distal origin in base axes, about the base origin
   /// instead (parallel axes: its bodies at rho sit at rho + r).
   /// \param[in,out] I The inertia, moved in place.
-  void shift_to_base(RigidInertia<Scalar>& I) const {
+  EIGEN_ALWAYS_INLINE void shift_to_base(RigidInertia<Scalar>& I) const {
     if constexpr (Shifts) {
       detail::add_shift(I.inertia, r_, Vector3(I.first_moment + Scalar(0.5) * I.mass * r_));
       I.first_moment += I.mass * r_;
