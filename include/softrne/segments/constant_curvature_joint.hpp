@@ -293,10 +293,10 @@ struct ConstantCurvatureJoint {
     const Vector3 Iw = I * w, Dw = D_times(w);
     Vector3 c[2], Ic[2], Dc[2], CIw[2];  // c_i = w'_i x w, I c_i, D c_i, C(I, w'_i) w
     for (int i = 0; i < 2; ++i) {
-      c[i] = t.wr[i].cross(w);
+      c[i] = cross3(t.wr[i], w);
       Ic[i] = I * c[i];
       Dc[i] = D_times(c[i]);
-      CIw[i] = Ic[i] - t.wr[i].cross(Iw);
+      CIw[i] = Ic[i] - cross3(t.wr[i], Iw);
     }
     Vector3 Tw[2], Tc[2][2];  // T_j w, T_j c_i
     for (int j = 0; j < 2; ++j) {
@@ -321,12 +321,12 @@ struct ConstantCurvatureJoint {
                     t.a_w * (dpw[j] * t.dp[i] + dpw[i] * t.dp[j]);
         if (i == j) h += Scalar(2) * Dw;
         // C(T_j, w'_i) w + C(T_i, w'_j) w
-        h += Tc[j][i] - t.wr[i].cross(Tw[j]) + Tc[i][j] - t.wr[j].cross(Tw[i]);
+        h += Tc[j][i] - cross3(t.wr[i], Tw[j]) + Tc[i][j] - cross3(t.wr[j], Tw[i]);
         // C(C(I, w'_i), w'_j) w, with C(I, w'_i) y = I (w'_i x y) - w'_i x I y
-        const Vector3 wc = t.wr[i].cross(c[j]);
-        h += I * wc - t.wr[i].cross(Ic[j]) - t.wr[j].cross(CIw[i]);
+        const Vector3 wc = cross3(t.wr[i], c[j]);
+        h += I * wc - cross3(t.wr[i], Ic[j]) - cross3(t.wr[j], CIw[i]);
         // C(I, d_i w'_j) w
-        h += I * dwr[j].cross(w) - dwr[j].cross(Iw);
+        h += I * cross3(dwr[j], w) - cross3(dwr[j], Iw);
         out[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] = h;
         if (j != i) out[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)] = h;
       }

@@ -43,7 +43,8 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> motion_to_wo
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, m.cols());
   out.template bottomRows<3>().noalias() = R * m.template bottomRows<3>();
   out.template topRows<3>().noalias() = R * m.template topRows<3>();
-  out.template topRows<3>().noalias() += skew(p) * out.template bottomRows<3>();
+  for (Eigen::Index j = 0; j < m.cols(); ++j)
+    out.col(j).template head<3>() += cross3(p, out.col(j).template tail<3>());
   return out;
 }
 
@@ -55,7 +56,8 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_wor
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, f.cols());
   out.template topRows<3>().noalias() = R * f.template topRows<3>();
   out.template bottomRows<3>().noalias() = R * f.template bottomRows<3>();
-  out.template bottomRows<3>().noalias() += skew(p) * out.template topRows<3>();
+  for (Eigen::Index j = 0; j < f.cols(); ++j)
+    out.col(j).template tail<3>() += cross3(p, out.col(j).template head<3>());
   return out;
 }
 
@@ -67,7 +69,8 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<double, 6, In::ColsAtCompileTime> force_to_loc
   Eigen::Matrix<double, 6, In::ColsAtCompileTime> out(6, f.cols());
   out.template topRows<3>().noalias() = R.transpose() * f.template topRows<3>();
   Eigen::Matrix<double, 3, In::ColsAtCompileTime> n = f.template bottomRows<3>();
-  n.noalias() -= skew(p) * f.template topRows<3>();
+  for (Eigen::Index j = 0; j < f.cols(); ++j)
+    n.col(j) -= cross3(p, f.col(j).template head<3>());
   out.template bottomRows<3>().noalias() = R.transpose() * n;
   return out;
 }
