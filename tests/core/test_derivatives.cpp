@@ -171,6 +171,14 @@ void check_aba(const DynamicChain<double>& chain, const VectorXd& q, const Vecto
   const int n = chain.num_coordinates();
   auto data = chain.make_data();
   aba_derivatives(chain, data, q, qd, tau);
+  // On the way, what forward_dynamics() leaves (M from the derivatives' composites, so equal
+  // to rounding), and the inverse dynamics at qddot* (data.tau) gives tau back.
+  auto ref = chain.make_data();
+  forward_dynamics(chain, ref, q, qd, tau);
+  EXPECT_TRUE(data.nonlinear_forces == ref.nonlinear_forces);
+  EXPECT_LT(rel_err(data.mass_matrix, ref.mass_matrix), 1e-13);
+  EXPECT_LT(rel_err(data.qddot, ref.qddot), 1e-12);
+  EXPECT_LT(rel_err(data.tau, tau), 1e-12);
   const MatrixXd dq = data.dqddot_dq, dqd = data.dqddot_dqdot, dtau = data.dqddot_dtau;
   EXPECT_LT(rel_err(dtau * data.mass_matrix, MatrixXd::Identity(n, n)), 1e-12);
   auto fd_data = chain.make_data();

@@ -65,7 +65,8 @@ struct is_fixed_axis_joint<Segment, std::void_t<decltype(Segment::fixed_axis)>>
 
 /// \brief A segment's distal frame in the world from its base frame (at the expansion point),
 /// and the world Jacobian of the distal frame's twist (6 x nq, columns of its coordinates).
-/// \param[in] motion_distal The distal frame's motion in its own axes (the RNE's).
+/// \param[in] motion_distal The distal frame's motion in its own axes (the RNE's; its omega is
+///   read).
 template <class Segment, class Qd, class JacobianT>
 void world_frame_step(const typename Segment::Kinematics& kin, const FrameInWorld& base,
                       const FrameMotion<double>& motion_distal, const Eigen::MatrixBase<Qd>& qdot,
@@ -102,10 +103,21 @@ void world_frame_step(const typename Segment::Kinematics& kin, const FrameInWorl
   }
   distal.twist.template head<3>() = distal.v + cross3(distal.p, w);
   distal.twist.template tail<3>() = w;
-  const Eigen::Vector3d alpha = distal.R * motion_distal.alpha;
-  distal.acceleration.template head<3>() = distal.R * motion_distal.acc;
-  distal.acceleration.template head<3>() += cross3(distal.p, alpha) - cross3(w, distal.v);
-  distal.acceleration.template tail<3>() = alpha;
+}
+
+/// \brief A frame's spatial acceleration about the world origin, \f$(a - \alpha\times p -
+/// \omega\times v;\ \alpha)\f$ in world axes (gravity in it, as in the RNE's accelerations),
+/// from its pose and twist in the world and the RNE's motion in its own axes. Apart from
+/// world_frame_step because the frames and composites do not depend on the accelerations
+/// (aba_derivatives forms M from them before it knows qddot).
+inline Vector6d spatial_acceleration(const FrameInWorld& frame,
+                                     const FrameMotion<double>& motion) {
+  Vector6d a;
+  a.template tail<3>() = frame.R * motion.alpha;
+  a.template head<3>() = frame.R * motion.acc;
+  a.template head<3>() += cross3(frame.p, a.template tail<3>()) -
+                          cross3(frame.twist.template tail<3>(), frame.v);
+  return a;
 }
 
 /// \brief The sensitivities (P | R)^T (9 x nq) that the bodies of `c` give coordinates moving
@@ -214,9 +226,10 @@ void own_body_composite(const Segment& seg, const typename Segment::Kinematics& 
   }
 }
 
-/// \brief At the expansion point the RNE left in data (kinematics, motions, loads): every
-/// frame in the world (ws.frames), every frame's SubtreeComposite (ws.subtrees), and every
-/// coordinate's Jacobian and sensitivities (ws.jacobian, ws.sensitivity). O(n). With `mass`,
+/// \brief At the expansion point the RNE left in data (kinematics, and the angular velocities of
+/// its motions and loads: none of this depends on qddot): every frame in the world
+/// (ws.frames), every frame's SubtreeComposite (ws.subtrees), and every coordinate's Jacobian
+/// and sensitivities (ws.jacobian, ws.sensitivity). O(n). With `mass`,
 /// also the mass matrix from the same composites (as Pinocchio's computeRNEADerivatives fills
 /// M): \f$M_{kj} = P_k J_j\f$ for j in an earlier segment than k (\f$\partial\tau_k/\partial\ddot
 /// q_j\f$: a unit \f$\ddot q_j\f$ is \f$\Delta A = J_j\f$), and a segment's own block
@@ -228,8 +241,7 @@ void compute_derivative_composites(const ChainT& chain, typename ChainT::Data& d
                                    typename ChainT::MatrixQ* mass) {
   auto& ws = data.derivatives;
   const InertiaRate rate = chain.inertia_rate;
-  ws.frames[0] = FrameInWorld{};  // the world: at rest, its acceleration -g (rnea_passes)
-  ws.frames[0].acceleration.template head<3>() = data.motion[0].acc;
+  ws.frames[0] = FrameInWorld{};  // the world: at rest
   chain.forward(data, [&](const auto& seg, const auto& kin, int k, int offset) {
     using Segment = std::decay_t<decltype(seg)>;
     constexpr int n = Segment::nq;

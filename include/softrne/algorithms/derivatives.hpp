@@ -41,8 +41,11 @@
 /// From \f$M(q)\ddot q = \tau - b(q,\dot q)\f$ with \f$\mathrm{ID}(q,\dot q,\ddot q) = M\ddot q +
 /// b\f$: \f$\partial\ddot q/\partial x = -M^{-1}\,\partial\mathrm{ID}/\partial x\f$ at the
 /// solution \f$\ddot q^*\f$ for x = q, qdot, and \f$\partial\ddot q/\partial\tau = M^{-1}\f$.
-/// aba_derivatives computes \f$\ddot q^*\f$, M and its Cholesky factor by forward_dynamics()
-/// and the partials of ID by the same passes as rnea_derivatives.
+/// aba_derivatives computes \f$\ddot q^*\f$ as forward_dynamics() does, but takes M from the
+/// composites the partials need anyway (they depend on q and qdot only, so they come first):
+/// one mass-matrix pass fewer (8 % of its instructions on the paper's arm, 15 % on a 6-joint
+/// revolute chain; docs/performance.md). The partials of ID then come from the same passes as
+/// rnea_derivatives.
 
 #include <limits>
 #include <tuple>
@@ -203,7 +206,8 @@ void fixed_axis_derivatives(Data& data, int s, int i) {
   dV.col(0) = cross_motion(V, S);
   dV.col(1) = S;
   Eigen::Matrix<double, 9, kDerivativeBlock> x;  // (a~; dV's angular part)
-  x.template topRows<6>().col(0) = cross_motion(base.acceleration, S) + cross_motion(V, dV.col(0));
+  x.template topRows<6>().col(0) =
+      cross_motion(spatial_acceleration(base, data.motion[k]), S) + cross_motion(V, dV.col(0));
   x.template topRows<6>().col(1) = 2.0 * dV.col(0);
   x.template bottomRows<3>() = dV.template bottomRows<3>();
   store_coordinates_after(data, i, i, x);
@@ -428,33 +432,24 @@ void autodiff_segment_derivatives(const ChainT& chain, typename ChainT::Data& da
 /// \brief \f$\partial\tau/\partial q\f$ and \f$\partial\tau/\partial\dot q\f$ of the RNE at
 /// (q, qdot, qddot) into data.dtau_dq and data.dtau_dqdot (the file comment: one block
 /// (q_i, qdot_i) per coordinate, AutoDiff on the coordinate's own segment, the composites of
-/// derivative_composites.hpp elsewhere); tau itself into data.tau, the RNE's kinematics,
-/// motions, loads and wrenches at that point into data, and with `with_mass_matrix`
-/// \f$\partial\tau/\partial\ddot q = M\f$ from the same composites into data.mass_matrix.
-/// `kinematics_ready`: data's kinematics are already those at (q, qdot) (forward_dynamics()
-/// just ran on data), so they are not computed again.
+/// derivative_composites.hpp elsewhere), once data holds the RNE at that point
+/// (compute_kinematics, then rnea_passes with qddot: kinematics, motions, loads, wrenches) and
+/// the composites (compute_derivative_composites) and the workspace is prepared
+/// (prepare_derivatives).
 template <class ChainT, class Q, class Qd, class Qdd>
-void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
-                            const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
-                            const Eigen::MatrixBase<Qdd>& qddot, bool with_mass_matrix,
-                            bool kinematics_ready = false) {
+void derivative_columns(const ChainT& chain, typename ChainT::Data& data,
+                        const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
+                        const Eigen::MatrixBase<Qdd>& qddot) {
   static_assert(std::is_floating_point_v<typename ChainT::Scalar>,
                 "softrne: derivatives need a chain of a floating-point scalar");
-  prepare_derivatives(chain, data);
   auto& ws = data.derivatives;
   using AD = typename std::decay_t<decltype(ws)>::AD;
   const int nq = chain.num_coordinates(), n_seg = data.num_segments();
-
-  // The expansion point, in double: what rnea() computes, kept in data.
-  if (!kinematics_ready) compute_kinematics(chain, data, q, qdot);
-  rnea_passes(chain, data, qdot, qddot, true, true, data.tau);
   for (int i = 0; i < nq; ++i) {
     ws.q(i) = AD(q(i));
     ws.qdot(i) = AD(qdot(i));
     ws.qddot(i) = AD(qddot(i));
   }
-
-  compute_derivative_composites(chain, data, qdot, with_mass_matrix ? &data.mass_matrix : nullptr);
   for (int s = 0; s < n_seg; ++s)
     chain.visit_segment(data, s, [&](const auto& seg, const auto& kin, int, int offset) {
       using Segment = std::decay_t<decltype(seg)>;
@@ -466,6 +461,22 @@ void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
         autodiff_segment_derivatives<Segment::nq>(chain, data, s, offset);
       // (a segment without coordinates, a rigid link, has no columns)
     });
+}
+
+/// \brief \f$\partial\tau/\partial q\f$ and \f$\partial\tau/\partial\dot q\f$ of the RNE at
+/// (q, qdot, qddot) into data.dtau_dq and data.dtau_dqdot, from nothing: the RNE at that
+/// point (tau into data.tau; kinematics, motions, loads and wrenches kept in data), the
+/// composites, with `with_mass_matrix` \f$\partial\tau/\partial\ddot q = M\f$ from them into
+/// data.mass_matrix, then derivative_columns().
+template <class ChainT, class Q, class Qd, class Qdd>
+void rnea_derivative_passes(const ChainT& chain, typename ChainT::Data& data,
+                            const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot,
+                            const Eigen::MatrixBase<Qdd>& qddot, bool with_mass_matrix) {
+  prepare_derivatives(chain, data);
+  compute_kinematics(chain, data, q, qdot);
+  rnea_passes(chain, data, qdot, qddot, true, true, data.tau);
+  compute_derivative_composites(chain, data, qdot, with_mass_matrix ? &data.mass_matrix : nullptr);
+  derivative_columns(chain, data, q, qdot, qddot);
 }
 
 }  // namespace detail
@@ -514,8 +525,9 @@ void rnea_derivatives(const ChainT& chain, typename ChainT::Data& data,
 /// \param[in] chain The model.
 /// \param[in,out] data Its workspace, made by chain.make_data(); receives data.dqddot_dq,
 ///   data.dqddot_dqdot, data.dqddot_dtau (= M^-1) and, on the way, what forward_dynamics()
-///   leaves (data.qddot, data.mass_matrix, data.mass_factor, data.nonlinear_forces) and the
-///   inverse-dynamics partials at qddot* (data.dtau_dq, data.dtau_dqdot, data.tau).
+///   leaves (data.qddot, data.mass_matrix, data.mass_factor, data.nonlinear_forces; M from
+///   the composites, equal to mass_matrix()'s to rounding) and the inverse-dynamics partials at
+///   qddot* (data.dtau_dq, data.dtau_dqdot, data.tau).
 /// \param[in] q The coordinates (dim chain.num_coordinates()).
 /// \param[in] qdot Their rates (dim chain.num_coordinates()).
 /// \param[in] tau Every generalised force other than inertia and gravity (dim
@@ -531,18 +543,25 @@ void aba_derivatives(const ChainT& chain, typename ChainT::Data& data,
   detail::check_argument(chain, "aba_derivatives", "qdot", qdot);
   detail::check_argument(chain, "aba_derivatives", "tau", tau);
   chain.check_data(data);
-  forward_dynamics(chain, data, q, qdot, tau);  // qddot*, M, its Cholesky factor
+  detail::prepare_derivatives(chain, data);
+  // forward_dynamics() but for M, which comes from the composites (they need the velocities
+  // only, so they are formed before qddot is known): C qdot + G, M, then qddot*.
+  compute_kinematics(chain, data, q, qdot);
+  data.qdot_zero.setZero();
+  detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);
+  detail::compute_derivative_composites(chain, data, qdot, &data.mass_matrix);
+  detail::solve_for_qddot(data, tau);
   if (!data.qddot.allFinite()) {
-    detail::prepare_derivatives(chain, data);  // sizes the outputs of a runtime chain
     constexpr double nan = std::numeric_limits<double>::quiet_NaN();
     data.dqddot_dq.setConstant(nan);
     data.dqddot_dqdot.setConstant(nan);
     data.dqddot_dtau.setConstant(nan);
     return;
   }
-  // forward_dynamics left the kinematics at (q, qdot) in data.
-  detail::rnea_derivative_passes(chain, data, q, qdot, data.qddot, false, true);
-  // M^-1 from the factor forward_dynamics left (cholesky.hpp), then the two products.
+  // The inverse dynamics' partials at qddot*.
+  detail::rnea_passes(chain, data, qdot, data.qddot, true, true, data.tau);
+  detail::derivative_columns(chain, data, q, qdot, data.qddot);
+  // M^-1 from the factor (cholesky.hpp), then the two products.
   detail::cholesky_inverse_factored(data.mass_factor, data.dqddot_dtau);
   data.dqddot_dq.noalias() = -data.dqddot_dtau * data.dtau_dq;
   data.dqddot_dqdot.noalias() = -data.dqddot_dtau * data.dtau_dqdot;

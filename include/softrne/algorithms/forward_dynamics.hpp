@@ -10,6 +10,21 @@
 #include "softrne/algorithms/mass_matrix.hpp"
 
 namespace softrne {
+namespace detail {
+
+/// \brief The last step of forward_dynamics(), once data.mass_matrix and data.nonlinear_forces
+/// hold M and C qdot + G: M's Cholesky factor into data.mass_factor and \f$\ddot q = M^{-1}(\tau
+/// - C\dot q - G)\f$ into data.qddot (NaN if M is not positive definite). aba_derivatives()
+/// shares it (its M comes from the derivatives' composites).
+template <class Data, class Tau>
+void solve_for_qddot(Data& data, const Eigen::MatrixBase<Tau>& tau) {
+  data.qddot = tau - data.nonlinear_forces;
+  data.mass_factor = data.mass_matrix;
+  if (!cholesky_solve_in_place(data.mass_factor, data.qddot))
+    data.qddot.setConstant(std::numeric_limits<double>::quiet_NaN());
+}
+
+}  // namespace detail
 
 /// \brief \f$\ddot q = M(q)^{-1}(\tau - C(q,\dot q)\dot q - G(q))\f$, where tau holds every
 /// other generalised force (pressures \f$K_{prs}p\f$, springs \f$-K q\f$, dampers
@@ -38,10 +53,7 @@ const typename ChainT::VectorQ& forward_dynamics(const ChainT& chain, typename C
   detail::check_argument(chain, "forward_dynamics", "qdot", qdot);
   detail::check_argument(chain, "forward_dynamics", "tau", tau);
   mass_matrix_and_bias(chain, data, q, qdot);
-  data.qddot = tau - data.nonlinear_forces;
-  data.mass_factor = data.mass_matrix;
-  if (!detail::cholesky_solve_in_place(data.mass_factor, data.qddot))
-    data.qddot.setConstant(std::numeric_limits<double>::quiet_NaN());
+  detail::solve_for_qddot(data, tau);
   return data.qddot;
 }
 

@@ -43,9 +43,6 @@ struct FrameInWorld {
   Eigen::Vector3d p = Eigen::Vector3d::Zero();      ///< origin
   Eigen::Vector3d v = Eigen::Vector3d::Zero();      ///< velocity of the origin
   Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();  ///< (v_O; omega)
-  /// Its spatial acceleration about the world origin, \f$(a - \alpha\times p - \omega\times v;
-  /// \alpha)\f$ (gravity in it, as in the RNE's accelerations).
-  Eigen::Matrix<double, 6, 1> acceleration = Eigen::Matrix<double, 6, 1>::Zero();
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
