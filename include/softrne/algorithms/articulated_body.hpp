@@ -62,6 +62,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/algorithms/bias.hpp"
 #include "softrne/algorithms/cholesky.hpp"
 #include "softrne/algorithms/kinematics.hpp"
 #include "softrne/algorithms/mass_matrix.hpp"
@@ -263,9 +264,7 @@ const typename ChainT::VectorQ& aba(const ChainT& chain, typename ChainT::Data& 
   detail::check_argument(chain, "aba", "q", q);
   detail::check_argument(chain, "aba", "qdot", qdot);
   detail::check_argument(chain, "aba", "tau", tau);
-  compute_kinematics(chain, data, q, qdot);
-  data.qdot_zero.setZero();
-  detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);
+  detail::kinematics_and_nonlinear_forces(chain, data, q, qdot);
   data.qddot = tau - data.nonlinear_forces;
   if (!detail::articulated_passes(chain, data))
     data.qddot.setConstant(std::numeric_limits<double>::quiet_NaN());

@@ -54,4 +54,19 @@ const typename ChainT::VectorQ& bias(const ChainT& chain, typename ChainT::Data&
   return data.bias_forces;
 }
 
+namespace detail {
+
+/// \brief C(q, qdot) qdot + G(q) into data.nonlinear_forces, leaving data's kinematics at
+/// (q, qdot): the first half of the forward dynamics (eq. 23), shared by
+/// mass_matrix_and_bias(), aba() and aba_derivatives().
+template <class ChainT, class Q, class Qd>
+void kinematics_and_nonlinear_forces(const ChainT& chain, typename ChainT::Data& data,
+                                     const Eigen::MatrixBase<Q>& q,
+                                     const Eigen::MatrixBase<Qd>& qdot) {
+  compute_kinematics(chain, data, q, qdot);
+  data.qdot_zero.setZero();
+  rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);
+}
+
+}  // namespace detail
 }  // namespace softrne

@@ -113,10 +113,9 @@ void world_frame_step(const typename Segment::Kinematics& kin, const FrameInWorl
 inline Vector6d spatial_acceleration(const FrameInWorld& frame,
                                      const FrameMotion<double>& motion) {
   Vector6d a;
-  a.template tail<3>() = frame.R * motion.alpha;
-  a.template head<3>() = frame.R * motion.acc;
-  a.template head<3>() += cross3(frame.p, a.template tail<3>()) -
-                          cross3(frame.twist.template tail<3>(), frame.v);
+  a.tail<3>() = frame.R * motion.alpha;
+  a.head<3>() = frame.R * motion.acc;
+  a.head<3>() += cross3(frame.p, a.tail<3>()) - cross3(frame.twist.tail<3>(), frame.v);
   return a;
 }
 

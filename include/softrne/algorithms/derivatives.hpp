@@ -55,6 +55,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/algorithms/bias.hpp"
 #include "softrne/algorithms/cholesky.hpp"
 #include "softrne/algorithms/derivative_composites.hpp"
 #include "softrne/algorithms/forward_dynamics.hpp"
@@ -546,9 +547,7 @@ void aba_derivatives(const ChainT& chain, typename ChainT::Data& data,
   detail::prepare_derivatives(chain, data);
   // forward_dynamics() but for M, which comes from the composites (they need the velocities
   // only, so they are formed before qddot is known): C qdot + G, M, then qddot*.
-  compute_kinematics(chain, data, q, qdot);
-  data.qdot_zero.setZero();
-  detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);
+  detail::kinematics_and_nonlinear_forces(chain, data, q, qdot);
   detail::compute_derivative_composites(chain, data, qdot, &data.mass_matrix);
   detail::solve_for_qddot(data, tau);
   if (!data.qddot.allFinite()) {

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "softrne/algorithms/bias.hpp"
 #include "softrne/algorithms/kinematics.hpp"
 #include "softrne/algorithms/own_inertia.hpp"
 #include "softrne/algorithms/rnea.hpp"
@@ -245,9 +246,7 @@ void mass_matrix_and_bias(const ChainT& chain, typename ChainT::Data& data,
                           const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Qd>& qdot) {
   detail::check_argument(chain, "mass_matrix_and_bias", "q", q);
   detail::check_argument(chain, "mass_matrix_and_bias", "qdot", qdot);
-  compute_kinematics(chain, data, q, qdot);
-  data.qdot_zero.setZero();
-  detail::rnea_passes(chain, data, qdot, data.qdot_zero, true, true, data.nonlinear_forces);
+  detail::kinematics_and_nonlinear_forces(chain, data, q, qdot);
   detail::mass_matrix_passes(chain, data);
 }
 
